@@ -1,0 +1,82 @@
+"""From a policy action to a (v, w) command: the piece between the policy (5 Hz) and the wheels.
+
+Both controllers have the same two calls, used identically by the simulator and the real robot:
+
+* ``set_action(action, state)`` once per agent step (0.2 s);
+* ``command(state) -> Command`` at the planner rate (every 0.1 s by default).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from lbgp.actions import goal_from_action, velocity_from_action
+from lbgp.geometry import from_frame
+from lbgp.planner import OK, Plan, PlannerConfig, TebPlanner, clamp_command
+from lbgp.world import WorldState
+
+
+@dataclasses.dataclass
+class Command:
+    v: float
+    w: float
+    status: str = OK
+    goal: np.ndarray | None = None  # world (x, y, yaw) of the current goal, if any
+    plan: Plan | None = None
+
+
+class VelocityController:
+    """E2E: the action is the (v, w) command itself (clamped to the robot's limits)."""
+
+    kind = "velocity"
+
+    def __init__(self, limits: PlannerConfig):
+        self.limits = limits
+        self._vw = (0.0, 0.0)
+
+    def reset(self) -> None:
+        self._vw = (0.0, 0.0)
+
+    def set_action(self, action, state: WorldState) -> None:
+        self._vw = velocity_from_action(action)
+
+    def command(self, state: WorldState) -> Command:
+        v_now, w_now = (float(x) for x in state.robot_velocity)
+        v, w = clamp_command(self._vw[0], self._vw[1], v_now, w_now, self.limits)
+        return Command(v, w)
+
+
+class GoalController:
+    """LBGP/HC: the action is a goal in the person frame; the TEB planner drives there.
+
+    The goal stays fixed in the person frame while the person walks, so it is re-expressed in the
+    world at every planner call, heading along the person's heading, and the band arrives with the
+    person's speed.
+    """
+
+    kind = "goal"
+
+    def __init__(self, planner: TebPlanner):
+        self.planner = planner
+        self.goal_person = np.array([1.5, 0.0])
+
+    def reset(self) -> None:
+        self.planner.reset()
+        self.goal_person = np.array([1.5, 0.0])
+
+    def set_action(self, action, state: WorldState) -> None:
+        self.set_goal(goal_from_action(action))
+
+    def set_goal(self, goal_person_xy) -> None:
+        """Set the goal directly in metres in the person frame (used by scripted and HC goals)."""
+        self.goal_person = np.asarray(goal_person_xy, dtype=float).reshape(2)
+
+    def command(self, state: WorldState) -> Command:
+        goal = from_frame(np.array([self.goal_person[0], self.goal_person[1], 0.0]), state.person_pose)
+        plan = self.planner.plan(
+            state.robot_pose, state.robot_velocity, goal, state.person_pose, state.person_velocity,
+            goal_speed=state.person_speed,
+        )
+        return Command(plan.v, plan.w, plan.status, goal, plan)

@@ -1,0 +1,105 @@
+"""The policy's observation, built by the same code in simulation and on the real robot.
+
+Frames arrive at 5 Hz (one per control step). From the last 10 frames the observation stacks, as
+the paper does, the robot's relative state z^r and the person's past poses z^h, all expressed in
+the *current* person frame:
+
+    index  0..2                  z^r_t       = (x, y, phi) of the robot now
+    index  3 + 6(i-1) .. +2      z^h_{t-i}   = (x, y, phi) of the person i frames ago, i = 1..9
+    index  6 + 6(i-1) .. +2      z^r_{t-i}   = (x, y, phi) of the robot i frames ago
+                                 (z^h_t is the origin and is left out) -> 57 numbers in all.
+
+Scaling to [-1, 1]: x and y are divided by ``POSITION_SCALE`` = 6 m, phi by pi, then clipped. At
+the start of an episode the history is filled with copies of the first frame.
+
+Optional Gaussian noise (std ``noise_std`` = (metres, radians)) is added to the relative states
+before scaling; it is on in training levels and off in evaluation scenarios by default.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+
+import numpy as np
+
+from lbgp.geometry import to_frame
+
+FRAMES = 10
+FRAME_PERIOD = 0.2  # s, 5 Hz
+POSITION_SCALE = 6.0  # m
+ANGLE_SCALE = math.pi
+SIZE = 3 + 6 * (FRAMES - 1)
+DEFAULT_NOISE_STD = (0.03, 0.03)  # m, rad
+
+
+class ObservationStack:
+    """Keeps the last 10 (robot, person) world-pose frames and builds the scaled observation."""
+
+    def __init__(self, frames: int = FRAMES, noise_std=None):
+        self.frames = frames
+        self.noise_std = noise_std
+        self._history: collections.deque = collections.deque(maxlen=frames)
+
+    @property
+    def size(self) -> int:
+        return 3 + 6 * (self.frames - 1)
+
+    def reset(self, robot_pose, person_pose) -> None:
+        self._history.clear()
+        for _ in range(self.frames):
+            self.push(robot_pose, person_pose)
+
+    def push(self, robot_pose, person_pose) -> None:
+        robot_pose = np.asarray(robot_pose, dtype=float).copy()
+        person_pose = np.asarray(person_pose, dtype=float).copy()
+        if not (np.all(np.isfinite(robot_pose)) and np.all(np.isfinite(person_pose))):
+            raise ValueError("observation frame has a non-finite pose")
+        if not self._history:
+            self._history.extend([(robot_pose, person_pose)] * self.frames)
+        self._history.append((robot_pose, person_pose))
+
+    def relative_states(self) -> tuple[np.ndarray, np.ndarray]:
+        """(robot, person) relative states, newest first, each (frames, 3), in the current person frame."""
+        robots = np.array([r for r, _ in reversed(self._history)])
+        persons = np.array([p for _, p in reversed(self._history)])
+        frame = persons[0]
+        return to_frame(robots, frame), to_frame(persons, frame)
+
+    def vector(self, rng: np.random.Generator | None = None) -> np.ndarray:
+        z_r, z_h = self.relative_states()
+        if self.noise_std is not None and rng is not None:
+            std = np.array([self.noise_std[0], self.noise_std[0], self.noise_std[1]])
+            z_r = z_r + rng.normal(0.0, 1.0, z_r.shape) * std
+            z_h = z_h + rng.normal(0.0, 1.0, z_h.shape) * std
+            z_h[0] = 0.0  # the current person pose is the frame's origin by definition
+        return scale(layout(z_r, z_h))
+
+
+def layout(z_r: np.ndarray, z_h: np.ndarray) -> np.ndarray:
+    """Interleave relative states newest first: z^r_t, z^h_{t-1}, z^r_{t-1}, ..., z^h_{t-9}, z^r_{t-9}."""
+    parts = [z_r[0]]
+    for i in range(1, len(z_r)):
+        parts.append(z_h[i])
+        parts.append(z_r[i])
+    return np.concatenate(parts)
+
+
+def scale(raw: np.ndarray) -> np.ndarray:
+    raw = np.asarray(raw, dtype=float)
+    scales = np.tile([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE], len(raw) // 3)
+    return np.clip(raw / scales, -1.0, 1.0).astype(np.float32)
+
+
+def unscale(obs: np.ndarray) -> np.ndarray:
+    """Metric relative states back from a (noise-free, unclipped) observation vector."""
+    obs = np.asarray(obs, dtype=float)
+    scales = np.tile([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE], len(obs) // 3)
+    return obs * scales
+
+
+def estimate_person_velocity(prev_pose, pose, dt: float) -> np.ndarray:
+    """Person world velocity (vx, vy) by finite difference of two poses ``dt`` seconds apart."""
+    if dt <= 0:
+        return np.zeros(2)
+    return (np.asarray(pose[:2], dtype=float) - np.asarray(prev_pose[:2], dtype=float)) / dt

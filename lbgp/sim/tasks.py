@@ -1,0 +1,328 @@
+"""Follow-ahead tasks in the dm_control style. Read top to bottom: physics, task (levels and
+scenarios), observations, reward.
+
+A robot (Jackal or TurtleBot 2) tries to stay 1.5 m straight in front of a walking person. The
+person is a mocap body moved along its motion model; the robot is driven through its wheel
+actuators by a controller (goal -> planner -> (v, w), or (v, w) directly).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable
+
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+from dm_control.rl import control
+from dm_env import specs
+
+from lbgp.control import Command, GoalController, VelocityController
+from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar
+from lbgp.planner import TebPlanner, planner_config_for
+from lbgp.sim import observation as obs_lib
+from lbgp.sim import paths as path_lib
+from lbgp.sim.person import CircleMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
+from lbgp.sim.rewards import follow_ahead_reward, out_of_range
+from lbgp.sim.robots import RobotSpec, actuator_indices
+from lbgp.world import WorldState
+
+CONTROL_PERIOD = 0.2  # s, one agent step = one observation frame
+DEFAULT_HORIZON = 35  # agent steps (the authors' configuration; the paper does not state it)
+
+
+# ============================================================================ physics
+class Physics(dm_mujoco.Physics):
+    """MuJoCo physics of one scene (robot + person + floor) with planar accessors."""
+
+    def setup_robot(self, spec: RobotSpec) -> None:
+        import mujoco
+
+        model = self.model.ptr
+        self.spec = spec
+        self.left, self.right = actuator_indices(model, spec)
+        self.robot_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "robot")
+        joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "robot_root")
+        person = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "person")
+        if min(self.robot_body, joint, person) < 0:
+            raise ValueError(f"scene {spec.scene_path} lacks the body 'robot', joint 'robot_root' or body 'person'")
+        self.qpos_adr = int(model.jnt_qposadr[joint])
+        self.qvel_adr = int(model.jnt_dofadr[joint])
+        self.mocap_id = int(model.body_mocapid[person])
+        robot_geoms = model.body_rootid[model.geom_bodyid] == self.robot_body
+        person_geoms = (model.geom_bodyid == person) & (model.geom_contype != 0)
+        # contact_pair[g1, g2]: a contact between these two geoms is a robot-person contact
+        self.contact_pair = np.outer(robot_geoms, person_geoms) | np.outer(person_geoms, robot_geoms)
+        self.drive = spec.drive
+        self._raw_model, self._raw_data = model, self.data.ptr
+
+    # -- robot
+    def robot_pose(self) -> np.ndarray:
+        q = self._raw_data.qpos[self.qpos_adr : self.qpos_adr + 7]
+        yaw = math.atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] ** 2 + q[6] ** 2))
+        return np.array([q[0], q[1], yaw])
+
+    def robot_velocity(self) -> np.ndarray:
+        """(v, w): forward speed in the robot frame and yaw rate."""
+        qv = self._raw_data.qvel[self.qvel_adr : self.qvel_adr + 6]
+        yaw = self.robot_pose()[2]
+        return np.array([qv[0] * math.cos(yaw) + qv[1] * math.sin(yaw), qv[5]])
+
+    def set_robot_pose(self, pose) -> None:
+        x, y, yaw = (float(p) for p in pose)
+        adr = self.qpos_adr
+        z = self.model.body_pos[self.robot_body][2]
+        self.data.qpos[adr : adr + 7] = [x, y, z, math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+        self.data.qvel[self.qvel_adr : self.qvel_adr + 6] = 0.0
+        self.forward()
+
+    def drive_wheels(self, v: float, w: float) -> None:
+        left, right = self.drive.wheel_speeds(v, w)
+        ctrl = self._raw_data.ctrl
+        ctrl[self.left] = left
+        ctrl[self.right] = right
+
+    # -- person
+    def set_person_pose(self, pose) -> None:
+        x, y, yaw = pose[0], pose[1], pose[2]
+        data = self._raw_data
+        data.mocap_pos[self.mocap_id] = (x, y, 0.0)
+        data.mocap_quat[self.mocap_id] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+    def step_physics(self, nstep: int) -> None:
+        """``nstep`` raw MuJoCo steps (dm_control's ``step`` adds per-call work we do not need)."""
+        import mujoco
+
+        mujoco.mj_step(self._raw_model, self._raw_data, nstep)
+
+    def robot_person_contact(self) -> bool:
+        data = self._raw_data
+        if data.ncon == 0:
+            return False
+        geoms = data.contact.geom
+        return bool(self.contact_pair[geoms[:, 0], geoms[:, 1]].any())
+
+    def warnings(self) -> dict[str, int]:
+        """MuJoCo warnings raised so far (name -> count), e.g. to check a model is stable."""
+        import mujoco
+
+        return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(self.data.warning) if w.number}
+
+
+def load_physics(spec: RobotSpec) -> Physics:
+    """Compile the robot's scene; a malformed MJCF raises a ValueError naming the file."""
+    try:
+        physics = Physics.from_xml_path(str(spec.scene_path))
+    except Exception as exc:  # dm_control raises several error types for bad XML
+        raise ValueError(f"cannot load MJCF scene {spec.scene_path}: {exc}") from exc
+    physics.setup_robot(spec)
+    return physics
+
+
+# ============================================================================ task: levels and scenarios
+@dataclasses.dataclass(frozen=True)
+class Setting:
+    """How an episode starts and how the person walks.
+
+    ``spawn`` is None for the training levels (robot 1-2.5 m away in a uniformly random direction,
+    with a uniformly random heading) or (D, alpha_deg) for the paper's fixed initial settings
+    (robot heading = person heading). ``noise`` is the default for observation noise.
+    """
+
+    name: str
+    motion: Callable[[], PersonMotion]
+    spawn: tuple[float, float] | None = None
+    noise: bool = True
+    random_person_heading: bool = True
+
+
+def _library_motion() -> PersonMotion:
+    return PathMotion(path_lib.training_library(), speed=None, start_fraction=0.3)
+
+
+def _eval_path_motion(name: str) -> Callable[[], PersonMotion]:
+    return lambda: PathMotion(path_lib.evaluation_path(name), speed=0.5)
+
+
+LEVELS: dict[str, Setting] = {
+    "straight": Setting("straight", lambda: StraightMotion()),
+    "circles": Setting("circles", lambda: CircleMotion()),
+    "smoothed": Setting("smoothed", lambda: SmoothedMotion()),
+    "trajectories": Setting("trajectories", _library_motion),
+}
+CURRICULUM = tuple(LEVELS)
+
+# The paper's evaluation settings. alpha = 0 is "robot straight in front" everywhere (as in the
+# reward); the paper's turning text swaps the ahead/behind angles, we do not. Inside the turn is
+# on the person's left for a left (w > 0) turn, hence +45 deg.
+_eval = dict(noise=False, random_person_heading=False)
+SCENARIOS: dict[str, Setting] = {
+    "straight_ahead": Setting("straight_ahead", lambda: StraightMotion(0.6), (1.5, 0.0), **_eval),
+    "straight_behind": Setting("straight_behind", lambda: StraightMotion(0.6), (1.5, 180.0), **_eval),
+    "turning_ahead": Setting("turning_ahead", lambda: CircleMotion(0.3, 0.3), (1.5, 0.0), **_eval),
+    "turning_behind": Setting("turning_behind", lambda: CircleMotion(0.3, 0.3), (1.5, 180.0), **_eval),
+    "turning_inside": Setting("turning_inside", lambda: CircleMotion(0.3, 0.3), (1.5, 45.0), **_eval),
+    "turning_outside": Setting("turning_outside", lambda: CircleMotion(0.3, 0.3), (1.5, -45.0), **_eval),
+    "trajectory_one": Setting("trajectory_one", _eval_path_motion("one"), (1.5, 0.0), **_eval),
+    "trajectory_two": Setting("trajectory_two", _eval_path_motion("two"), (1.5, 0.0), **_eval),
+    "trajectory_three": Setting("trajectory_three", _eval_path_motion("three"), (1.5, 0.0), **_eval),
+}
+
+ALL_SETTINGS = {**LEVELS, **SCENARIOS}
+
+
+def get_setting(name: str) -> Setting:
+    try:
+        return ALL_SETTINGS[name]
+    except KeyError:
+        raise ValueError(
+            f"unknown level or scenario {name!r}; levels: {', '.join(LEVELS)}; scenarios: {', '.join(SCENARIOS)}"
+        ) from None
+
+
+def path_setting(path, spawn=(1.5, 0.0), speed: float = 0.5) -> Setting:
+    """A scenario whose person walks a user-given path (array or CSV file of x,y waypoints)."""
+    points = path if isinstance(path, np.ndarray) else path_lib.load_path_csv(path)
+    points = path_lib.validate_path(points)
+    return Setting("custom_path", lambda: PathMotion(points, speed=speed), spawn, noise=False, random_person_heading=False)
+
+
+# ============================================================================ task
+class FollowAheadTask(control.Task):
+    """Stay 1.5 m in front of the person. One instance per (robot, setting, control mode)."""
+
+    def __init__(
+        self,
+        spec: RobotSpec,
+        setting: Setting,
+        control_mode: str = "goal",
+        obs_noise: bool | None = None,
+        noise_std=obs_lib.DEFAULT_NOISE_STD,
+        planner_config=None,
+        random: np.random.Generator | int | None = None,
+    ):
+        self.spec = spec
+        self.setting = setting
+        self.motion = setting.motion()
+        self.limits = planner_config or planner_config_for(spec)
+        if control_mode == "goal":
+            self.controller = GoalController(TebPlanner(self.limits))
+        elif control_mode == "velocity":
+            self.controller = VelocityController(self.limits)
+        else:
+            raise ValueError(f"unknown control mode {control_mode!r}; use 'goal' or 'velocity'")
+        self.control_mode = control_mode
+        noise_on = setting.noise if obs_noise is None else obs_noise
+        self.stack = obs_lib.ObservationStack(noise_std=noise_std if noise_on else None)
+        self.rng = random if isinstance(random, np.random.Generator) else np.random.default_rng(random)
+        self.person_pose = np.zeros(3)
+        self.person_cmd = (0.0, 0.0)
+        self._prev_person_pose = np.zeros(3)
+        self.time = 0.0
+        self.contact = False
+        self.last_command = Command(0.0, 0.0)
+
+    # -- episode start
+    def initialize_episode(self, physics: Physics) -> None:
+        yaw = float(self.rng.uniform(-math.pi, math.pi)) if self.setting.random_person_heading else 0.0
+        self.person_pose = self.motion.reset(self.rng, np.array([0.0, 0.0, yaw]))
+        self._prev_person_pose = self.person_pose.copy()
+        if self.setting.spawn is None:
+            distance = float(self.rng.uniform(1.0, 2.5))
+            alpha = float(self.rng.uniform(-math.pi, math.pi))
+            robot = pose_from_polar(self.person_pose, distance, alpha)
+            robot[2] = float(self.rng.uniform(-math.pi, math.pi))
+        else:
+            distance, alpha_deg = self.setting.spawn
+            robot = pose_from_polar(self.person_pose, distance, math.radians(alpha_deg))
+        physics.set_person_pose(self.person_pose)
+        physics.set_robot_pose(robot)
+        physics.drive_wheels(0.0, 0.0)
+        self.time = 0.0
+        self.contact = False
+        self.controller.reset()
+        self.last_command = Command(0.0, 0.0)
+        self.stack.reset(physics.robot_pose(), self.person_pose)
+        self.person_cmd = self.motion.command(self.person_pose, CONTROL_PERIOD)
+
+    def place_robot(self, physics: Physics, distance: float, alpha: float, relative_yaw: float = 0.0) -> None:
+        """Teleport the robot to (D, alpha) from the person (alpha in radians); for tests and tools."""
+        physics.set_robot_pose(pose_from_polar(self.person_pose, distance, alpha, relative_yaw))
+
+    # -- world state (what the observation and the controller see)
+    def world_state(self, physics: Physics) -> WorldState:
+        person_velocity = obs_lib.estimate_person_velocity(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
+        return WorldState(self.time, physics.robot_pose(), physics.robot_velocity(), self.person_pose.copy(), person_velocity)
+
+    # -- stepping (called by lbgp.sim.env.FollowAheadEnv)
+    def before_step(self, action, physics: Physics) -> None:
+        self.contact = False
+        self.controller.set_action(action, self.world_state(physics))
+
+    def apply_command(self, physics: Physics) -> Command:
+        """One controller tick: (v, w) from the controller, to wheel speeds."""
+        self.last_command = self.controller.command(self.world_state(physics))
+        physics.drive_wheels(self.last_command.v, self.last_command.w)
+        return self.last_command
+
+    def person_pose_at(self, dt) -> np.ndarray:
+        """The person's pose(s) ``dt`` seconds into the current step (exact arc of its command)."""
+        return integrate_unicycle(self._step_start_pose, self.person_cmd[0], self.person_cmd[1], dt)
+
+    def begin_person_step(self) -> None:
+        self._step_start_pose = self.person_pose.copy()
+
+    def move_person(self, physics: Physics, pose) -> None:
+        self.person_pose = np.asarray(pose, dtype=float)
+        physics.set_person_pose(self.person_pose)
+
+    def after_step(self, physics: Physics) -> None:
+        self.time += CONTROL_PERIOD
+        self._prev_person_pose = self._step_start_pose
+        self.stack.push(physics.robot_pose(), self.person_pose)
+        self.person_cmd = self.motion.command(self.person_pose, CONTROL_PERIOD)
+
+    # ======================================================================== observations
+    def observation_spec(self, physics=None):
+        return specs.BoundedArray((self.stack.size,), np.float32, -1.0, 1.0, name="observation")
+
+    def get_observation(self, physics: Physics) -> np.ndarray:
+        return self.stack.vector(self.rng)
+
+    def action_spec(self, physics=None):
+        return specs.BoundedArray((2,), np.float32, -1.0, 1.0, name=f"{self.control_mode}_action")
+
+    # ======================================================================== reward and termination
+    def distance_alpha(self, physics: Physics) -> tuple[float, float]:
+        return distance_and_alpha(physics.robot_pose(), self.person_pose)
+
+    def get_reward(self, physics: Physics) -> float:
+        return follow_ahead_reward(*self.distance_alpha(physics))
+
+    def get_termination(self, physics: Physics):
+        """0.0 (terminal) when D < 0.5 m, D > 5 m or the robot touches the person, else None."""
+        distance, _ = self.distance_alpha(physics)
+        if out_of_range(distance) or self.contact:
+            return 0.0
+        return None
+
+    def info(self, physics: Physics) -> dict:
+        """Everything that is not for the policy: metrics and raw poses for logging and plots."""
+        distance, alpha = self.distance_alpha(physics)
+        cmd = self.last_command
+        return {
+            "time": self.time,
+            "distance": distance,
+            "alpha": alpha,
+            "robot_pose": physics.robot_pose(),
+            "robot_velocity": physics.robot_velocity(),
+            "person_pose": self.person_pose.copy(),
+            "command": np.array([cmd.v, cmd.w]),
+            "planner_status": cmd.status,
+            "goal": None if cmd.goal is None else cmd.goal.copy(),
+            "band": None if cmd.plan is None else cmd.plan.poses.copy(),
+            "person_prediction": None if cmd.plan is None else cmd.plan.person_prediction.copy(),
+            "contact": self.contact,
+            "setting": self.setting.name,
+        }
+

@@ -39,6 +39,7 @@ class PlannerConfig:
     weight_forward_drive: float = 100.0  # (weight_kinematics_forward_drive)
     weight_clearance_slack: float = 1e3  # exact-penalty weight of a clearance violation (m)
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
+    slowdown_factors: tuple = (0.7, 0.5, 0.3, 0.15)  # speed-limit scales tried when the person crosses the band
     regularization: float = 1e-2  # proximal term of each SQP step
     # sequential QP
     sqp_iterations: int = 1  # iterations when warm-started (real-time iteration: the band keeps

@@ -30,10 +30,14 @@ forward-drive preference (backward segments penalised); a small proximal term.
 Constraints (linearised): first pose fixed at the robot; trust region; at every later pose a
 distance of at least the safety distance from the person's predicted position, as a half-plane
 through the linearisation point (elastic, see the slacks above). If after the step the next pose
-(the one the command drives to) is still inside the safety distance, the call returns a safe stop
-with status ``infeasible``: the robot never drives into the person's safety radius.
+(the one the command drives to) is inside the safety distance and closer to the person than the
+robot is now, the call returns a safe stop with status ``infeasible``: the robot never drives
+deeper into the person's safety radius (moving out of it, e.g. away from a person who walks
+towards the robot, is allowed).
 
-The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
+If the person's predicted path crosses the band at its time-optimal timing, the band is re-timed
+slower (``slowdown_factors`` of the speed limits) until it clears: the robot waits for the person
+to pass rather than racing them. The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
 limits over one control period, so the hard limits hold even when the band is only approximately
 feasible. Failures (bad input, goal inside the person's safety radius, infeasible QP, solver error,
 diverging band) return a safe stop (decelerate within limits) with a status that says why.
@@ -124,7 +128,12 @@ class TebPlanner:
 
     # ------------------------------------------------------------------ public
     def reset(self) -> None:
-        """Forget the previous band (the next call re-initialises)."""
+        """Forget the previous band (the next call re-initialises) and OSQP's state (warm start,
+        adapted step size), so that an episode's plans do not depend on the episodes before it."""
+        self._forget_band()
+        self._solver = None
+
+    def _forget_band(self) -> None:
         self._band = None
         self._goal = None
 
@@ -155,7 +164,7 @@ class TebPlanner:
         if not np.all(np.isfinite(values)):
             return self._stop(v_now, w_now, INVALID_INPUT, t_start)
         if np.linalg.norm(goal[:2] - person_pose[:2]) < cfg.safety_distance:
-            self.reset()
+            self._forget_band()
             return self._stop(v_now, w_now, GOAL_IN_COLLISION, t_start)
 
         warm = self._band is not None and np.linalg.norm(goal[:2] - self._goal[:2]) <= cfg.reinit_goal_jump
@@ -171,6 +180,7 @@ class TebPlanner:
             step, status = self._sqp_step(band, goal, person_pose[:2], person_vel)
             if status != OK:
                 break
+            step[[self.ix[0], self.iy[0], self.ith[0]]] = 0.0  # exact, not just to OSQP's tolerance
             band.poses[:, 0] += step[self.ix]
             band.poses[:, 1] += step[self.iy]
             band.poses[:, 2] += step[self.ith]
@@ -180,11 +190,20 @@ class TebPlanner:
             if float(np.max(np.abs(step))) < cfg.step_tolerance:
                 break
         if status != OK:
-            self.reset()
+            self._forget_band()
             return self._stop(v_now, w_now, status, t_start, band, person_pose[:2], person_vel, done)
         band.dt = self._timing(band, v_now, w_now, goal_speed)
-        if self._clearance(band, person_pose[:2], person_vel)[1] < cfg.safety_distance - cfg.clearance_tolerance:
-            self.reset()
+        clearance = self._clearance(band, person_pose[:2], person_vel)
+        if clearance[1:].min() < cfg.safety_distance - cfg.clearance_tolerance:
+            # the person would cross the band while we drive it: wait for them by driving it slower
+            for slower in cfg.slowdown_factors:
+                dt = self._timing(band, v_now, w_now, goal_speed, speed_scale=slower)
+                c = self._clearance(Band(band.poses, dt), person_pose[:2], person_vel)
+                if c[1:].min() >= cfg.safety_distance - cfg.clearance_tolerance:
+                    band.dt, clearance = dt, c
+                    break
+        if clearance[1] < cfg.safety_distance - cfg.clearance_tolerance and clearance[1] < clearance[0]:
+            self._forget_band()
             return self._stop(v_now, w_now, INFEASIBLE, t_start, band, person_pose[:2], person_vel, done)
         self._band, self._goal = band.copy(), goal.copy()
 
@@ -196,7 +215,7 @@ class TebPlanner:
         return self._result(v, w, OK, band, person_pose[:2], person_vel, done, t_start)
 
     # ------------------------------------------------------------------ helpers
-    def _timing(self, band: Band, v_now, w_now, goal_speed) -> np.ndarray:
+    def _timing(self, band: Band, v_now, w_now, goal_speed, speed_scale: float = 1.0) -> np.ndarray:
         cfg = self.cfg
         poses = band.poses
         d = poses[1:] - poses[:-1]
@@ -204,7 +223,7 @@ class TebPlanner:
         length = np.cos(mid) * d[:, 0] + np.sin(mid) * d[:, 1]
         return time_segments(
             length, d[:, 2], v_now, w_now, goal_speed,
-            cfg.max_vel_x, cfg.max_vel_x_backwards, cfg.max_vel_theta,
+            cfg.max_vel_x * speed_scale, cfg.max_vel_x_backwards * speed_scale, cfg.max_vel_theta,
             cfg.acc_lim_x, cfg.acc_lim_theta, cfg.dt_min,
         )
 
@@ -346,7 +365,7 @@ class TebPlanner:
             )
         else:
             self._solver.update(Px=Px, Ax=Ax, q=q, l=lo, u=hi)
-        result = self._solver.solve()
+        result = self._solver.solve(raise_error=False)
         status = result.info.status_val
         if status in _INFEASIBLE:
             return None, INFEASIBLE

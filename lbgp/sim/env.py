@@ -2,7 +2,7 @@
 
 Like dm_control's ``control.Environment``, but with the inner loops this task needs: per agent
 step (0.2 s) the controller is ticked every ``planner_period`` (the planner re-solves and sets the
-wheel speeds), and the person's mocap body is moved every ``person_substeps`` physics steps along
+wheel speeds), and the person's mocap body is moved every ``person_substeps`` physics steps (10 x 5 ms = 20 Hz by default) along
 the exact arc of its command.
 """
 
@@ -29,7 +29,7 @@ class FollowAheadEnv(dm_env.Environment):
         task: tasks.FollowAheadTask,
         horizon: int = tasks.DEFAULT_HORIZON,
         planner_period: float = 0.1,
-        person_substeps: int = 5,
+        person_substeps: int = 10,
     ):
         self.physics = physics
         self.task = task

@@ -78,24 +78,21 @@ class ObservationStack:
 
 def layout(z_r: np.ndarray, z_h: np.ndarray) -> np.ndarray:
     """Interleave relative states newest first: z^r_t, z^h_{t-1}, z^r_{t-1}, ..., z^h_{t-9}, z^r_{t-9}."""
-    parts = [z_r[0]]
-    for i in range(1, len(z_r)):
-        parts.append(z_h[i])
-        parts.append(z_r[i])
-    return np.concatenate(parts)
+    pairs = np.stack([z_h[1:], z_r[1:]], axis=1).reshape(-1)
+    return np.concatenate([z_r[0], pairs])
+
+
+_INV_SCALE = 1.0 / np.array([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE])
 
 
 def scale(raw: np.ndarray) -> np.ndarray:
-    raw = np.asarray(raw, dtype=float)
-    scales = np.tile([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE], len(raw) // 3)
-    return np.clip(raw / scales, -1.0, 1.0).astype(np.float32)
+    raw = np.asarray(raw, dtype=float).reshape(-1, 3) * _INV_SCALE
+    return np.clip(raw.ravel(), -1.0, 1.0).astype(np.float32)
 
 
 def unscale(obs: np.ndarray) -> np.ndarray:
     """Metric relative states back from a (noise-free, unclipped) observation vector."""
-    obs = np.asarray(obs, dtype=float)
-    scales = np.tile([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE], len(obs) // 3)
-    return obs * scales
+    return (np.asarray(obs, dtype=float).reshape(-1, 3) / _INV_SCALE).ravel()
 
 
 def estimate_person_velocity(prev_pose, pose, dt: float) -> np.ndarray:

@@ -80,6 +80,17 @@ def save_path_csv(path, points) -> None:
     tmp.replace(path)
 
 
+def resample_path(points, spacing: float = SPACING) -> np.ndarray:
+    """Waypoints every ``spacing`` metres along the polyline (end point kept), so that sparse user
+    paths track as well as dense ones."""
+    pts = validate_path(points)
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    keep = np.concatenate([[True], seg > 1e-9])
+    pts, cum = pts[keep], np.concatenate([[0.0], np.cumsum(seg[seg > 1e-9])])
+    s = np.append(np.arange(0.0, cum[-1], spacing), cum[-1])
+    return np.stack([np.interp(s, cum, pts[:, 0]), np.interp(s, cum, pts[:, 1])], axis=1)
+
+
 def path_length(points) -> float:
     pts = np.asarray(points, dtype=float)
     return float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from lbgp.geometry import wrap_angle
-from lbgp.sim.paths import validate_path
+from lbgp.sim.paths import resample_path
 
 
 class PersonMotion:
@@ -104,7 +104,7 @@ class PathMotion(PersonMotion):
     ):
         if isinstance(paths, np.ndarray):
             paths = [paths]
-        self.paths = [validate_path(p) for p in paths]
+        self.paths = [resample_path(p) for p in paths]
         self.fixed_speed = speed
         self.speed_range = speed_range
         self.start_fraction = start_fraction

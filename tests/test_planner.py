@@ -1,0 +1,197 @@
+"""The TEB planner: reaching goals within limits, keeping clear of the person, safe stops."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from lbgp.geometry import integrate_unicycle
+from lbgp.planner import (
+    GOAL_IN_COLLISION, INVALID_INPUT, JACKAL_PLANNER, OK, TURTLEBOT2_PLANNER, TebPlanner, safe_stop,
+)
+from lbgp.planner.timing import time_segments
+
+FAR = np.array([50.0, 50.0, 0.0])  # a person far away: free space
+PRESETS = {"jackal": JACKAL_PLANNER, "turtlebot2": TURTLEBOT2_PLANNER}
+
+
+def drive(planner, start, goal, person=FAR, person_vel=(0.0, 0.0), steps=80, period=0.1):
+    """Closed loop with an ideal unicycle; returns poses, commands and statuses."""
+    pose, v, w = np.asarray(start, float), 0.0, 0.0
+    person = np.asarray(person, float)
+    poses, cmds, statuses = [pose], [(0.0, 0.0)], []
+    for k in range(steps):
+        p_now = person + np.array([person_vel[0], person_vel[1], 0.0]) * k * period
+        plan = planner.plan(pose, (v, w), goal, p_now, person_vel)
+        statuses.append(plan.status)
+        v, w = plan.v, plan.w
+        pose = integrate_unicycle(pose, v, w, period)
+        poses.append(pose)
+        cmds.append((v, w))
+    return np.array(poses), np.array(cmds), statuses
+
+
+def assert_within_limits(cmds, cfg):
+    v, w = cmds[:, 0], cmds[:, 1]
+    eps = 1e-9
+    assert np.all(v <= cfg.max_vel_x + eps) and np.all(v >= -cfg.max_vel_x_backwards - eps)
+    assert np.all(np.abs(w) <= cfg.max_vel_theta + eps)
+    assert np.all(np.abs(np.diff(v)) <= cfg.acc_lim_x * cfg.control_period + eps)
+    assert np.all(np.abs(np.diff(w)) <= cfg.acc_lim_theta * cfg.control_period + eps)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    robot=st.sampled_from(sorted(PRESETS)),
+    start_yaw=st.floats(-math.pi, math.pi),
+    goal_dist=st.floats(0.5, 3.0),
+    goal_dir=st.floats(-math.pi, math.pi),
+    goal_yaw=st.floats(-math.pi, math.pi),
+)
+def test_reaches_free_space_goals_within_limits(robot, start_yaw, goal_dist, goal_dir, goal_yaw):
+    cfg = PRESETS[robot]
+    goal = np.array([goal_dist * math.cos(goal_dir), goal_dist * math.sin(goal_dir), goal_yaw])
+    poses, cmds, statuses = drive(TebPlanner(cfg), [0.0, 0.0, start_yaw], goal, steps=100)
+    assert set(statuses) == {OK}
+    assert np.linalg.norm(poses[-1, :2] - goal[:2]) < 0.1
+    assert_within_limits(cmds, cfg)
+
+
+def test_straight_goal_is_driven_fast_and_without_overshoot():
+    cfg = JACKAL_PLANNER
+    poses, cmds, _ = drive(TebPlanner(cfg), [0, 0, 0], np.array([3.0, 0.0, 0.0]), steps=40)
+    assert cmds[:, 0].max() == pytest.approx(cfg.max_vel_x)  # time-optimal: reaches top speed
+    assert poses[:, 0].max() < 3.1
+    assert np.linalg.norm(poses[-1, :2] - [3.0, 0.0]) < 0.05
+
+
+@pytest.mark.parametrize("robot", sorted(PRESETS))
+def test_goes_around_a_standing_person(robot):
+    cfg = PRESETS[robot]
+    person = np.array([1.5, 0.05, 0.0])
+    poses, cmds, statuses = drive(TebPlanner(cfg), [0, 0, 0], np.array([3.0, 0.0, 0.0]), person=person, steps=100)
+    clearance = np.linalg.norm(poses[:, :2] - person[:2], axis=1)
+    assert clearance.min() >= cfg.safety_distance - 0.03
+    assert np.linalg.norm(poses[-1, :2] - [3.0, 0.0]) < 0.1
+    assert_within_limits(cmds, cfg)
+
+
+def test_no_collision_with_a_person_crossing_the_path():
+    cfg = JACKAL_PLANNER
+    # the person walks across the robot's straight line to the goal, from the right, at 0.6 m/s
+    person0, vel = np.array([2.0, -2.0, math.pi / 2]), (0.0, 0.6)
+    poses, _, _ = drive(TebPlanner(cfg), [0, 0, 0], np.array([4.0, 0.0, 0.0]), person=person0, person_vel=vel, steps=80)
+    times = np.arange(len(poses)) * 0.1
+    people = person0[:2] + times[:, None] * np.array(vel)
+    clearance = np.linalg.norm(poses[:, :2] - people, axis=1)
+    assert clearance.min() > cfg.person_radius + cfg.footprint_radius
+    assert np.linalg.norm(poses[-1, :2] - [4.0, 0.0]) < 0.2
+
+
+def test_goal_inside_the_person_is_a_safe_stop():
+    cfg = JACKAL_PLANNER
+    plan = TebPlanner(cfg).plan([0, 0, 0], (1.0, 0.5), [2.0, 0.1], [2.0, 0.0, 0.0], (0.0, 0.0))
+    assert plan.status == GOAL_IN_COLLISION and not plan.ok
+    assert (plan.v, plan.w) == pytest.approx(safe_stop(1.0, 0.5, cfg))
+    assert plan.v == pytest.approx(1.0 - cfg.acc_lim_x * cfg.control_period)  # decelerating, not jumping
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ([0, float("nan"), 0], (0, 0), [1, 0], [5, 5, 0], (0, 0)),
+        ([0, 0, 0], (0, 0), [float("inf"), 0], [5, 5, 0], (0, 0)),
+        ([0, 0, 0], (0, 0), [1, 0], [5, 5, 0], (float("nan"), 0)),
+        ([0, 0], (0, 0), [1, 0], [5, 5, 0], (0, 0)),  # wrong shape
+        ([0, 0, 0], (0, 0), [1, 0], "person", (0, 0)),
+    ],
+)
+def test_degenerate_input_is_a_safe_stop_never_an_exception(args):
+    plan = TebPlanner(JACKAL_PLANNER).plan(*args)
+    assert plan.status == INVALID_INPUT
+    assert math.isfinite(plan.v) and math.isfinite(plan.w)
+    assert abs(plan.v) <= 1e-12 and abs(plan.w) <= 1e-12
+
+
+def test_safe_stop_from_nan_velocity_is_zero():
+    assert safe_stop(float("nan"), float("nan"), JACKAL_PLANNER) == (0.0, 0.0)
+
+
+def test_band_and_person_prediction_are_returned():
+    planner = TebPlanner(JACKAL_PLANNER)
+    plan = planner.plan([0, 0, 0], (0, 0), [2, 0, 0], [1, 3, 0], (0.5, 0.0))
+    assert plan.ok and plan.poses.shape == (JACKAL_PLANNER.n_poses, 3)
+    assert np.all(np.diff(plan.times) > 0)
+    np.testing.assert_allclose(plan.person_prediction[-1], [1 + 0.5 * plan.times[-1], 3.0])
+    np.testing.assert_allclose(plan.poses[0], [0, 0, 0], atol=1e-9)
+    assert np.linalg.norm(plan.poses[-1, :2] - [2, 0]) < 0.1
+
+
+def test_reset_makes_plans_reproducible():
+    planner = TebPlanner(JACKAL_PLANNER)
+    first = drive(planner, [0, 0, 0.3], np.array([2.0, 1.0, 0.0]), steps=10)[1]
+    planner.reset()
+    again = drive(planner, [0, 0, 0.3], np.array([2.0, 1.0, 0.0]), steps=10)[1]
+    np.testing.assert_array_equal(first, again)
+
+
+def test_timing_is_time_optimal_for_a_straight_band():
+    # 10 segments of 0.2 m from rest, top speed 1 m/s, acceleration 1 m/s^2, stopping at the end
+    dt = time_segments(np.full(10, 0.2), np.zeros(10), 0.0, 0.0, 0.0, 1.0, 0.2, 1.0, 1.0, 1.0, 0.01)
+    # v^2 <= 2 a s from both ends: peak speed sqrt(2 * 1 * 1) capped at 1 m/s in the middle
+    assert dt[0] == pytest.approx(0.2 / math.sqrt(0.4))
+    assert dt[5] == pytest.approx(0.2)  # cruising at 1 m/s
+    assert dt[-1] == pytest.approx(dt[0])
+    # turning on the spot is timed by the angular limits
+    dt = time_segments(np.zeros(3), np.full(3, 0.5), 0.0, 0.0, 0.0, 1.0, 0.2, 2.0, 1.0, 100.0, 0.01)
+    assert np.all(dt >= 0.25 - 1e-12)
+
+
+# ---------------------------------------------------------------- closed loop in MuJoCo
+def simulate(robot, start, goal, person0, person_vel, seconds=8.0):
+    """The planner drives the MuJoCo robot at 10 Hz towards a world-fixed goal while the person
+    (kinematic) walks at constant velocity. Returns robot-person distance at every 5 ms physics
+    step, whether they touched, and the final robot pose."""
+    from lbgp.sim.robots import get_robot
+    from lbgp.sim.tasks import load_physics
+
+    spec = get_robot(robot)
+    cfg = PRESETS[robot]
+    physics = load_physics(spec)
+    physics.set_robot_pose(start)
+    planner = TebPlanner(cfg)
+    dt = physics.model.opt.timestep
+    per_plan = int(round(cfg.control_period / dt))
+    distances, contact = [], False
+    vel = np.array([person_vel[0], person_vel[1], 0.0])
+    for k in range(int(seconds / cfg.control_period)):
+        t = k * cfg.control_period
+        person = np.asarray(person0, float) + vel * t
+        plan = planner.plan(physics.robot_pose(), physics.robot_velocity(), goal, person, person_vel)
+        physics.drive_wheels(plan.v, plan.w)
+        for j in range(per_plan):
+            physics.set_person_pose(np.asarray(person0, float) + vel * (t + (j + 1) * dt))
+            physics.step_physics(1)
+            contact = contact or physics.robot_person_contact()
+            p = physics.robot_pose()
+            distances.append(np.linalg.norm(p[:2] - (np.asarray(person0[:2]) + vel[:2] * (t + (j + 1) * dt))))
+    return np.array(distances), contact, physics.robot_pose()
+
+
+@pytest.mark.parametrize("robot", sorted(PRESETS))
+def test_mujoco_robot_keeps_the_safety_distance_around_a_standing_person(robot):
+    cfg = PRESETS[robot]
+    distances, contact, final = simulate(robot, [0, 0, 0], np.array([3.0, 0.0, 0.0]), [1.5, 0.05, 0.0], (0.0, 0.0))
+    assert not contact
+    assert distances.min() >= cfg.safety_distance - 0.05  # on the simulated trajectory, every 5 ms
+    assert np.linalg.norm(final[:2] - [3.0, 0.0]) < 0.15
+
+
+@pytest.mark.parametrize("robot", sorted(PRESETS))
+def test_mujoco_no_contact_with_a_person_crossing_the_path(robot):
+    distances, contact, final = simulate(robot, [0, 0, 0], np.array([4.0, 0.0, 0.0]), [2.0, -2.0, math.pi / 2], (0.0, 0.6), seconds=14.0)
+    assert not contact
+    assert distances.min() > 0.5
+    assert np.linalg.norm(final[:2] - [4.0, 0.0]) < 0.2

@@ -49,6 +49,34 @@ def cmd_demo(args) -> int:
     return 0
 
 
+def cmd_train(args) -> int:
+    from lbgp.agent.config import D4PGConfig
+    from lbgp.agent.train import train
+
+    if args.resume:
+        cfg = D4PGConfig(total_steps=args.steps or 0, time_limit_s=(args.minutes or 0) * 60.0)
+        summary = train(cfg, args.resume, resume=True, backend=args.backend)
+    else:
+        if not args.out:
+            raise ValueError("--out DIR is required (or --resume DIR)")
+        cfg = D4PGConfig(
+            method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
+            total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
+            num_actors=args.actors,
+        ).validate()
+        summary = train(cfg, args.out, backend=args.backend)
+    print(json.dumps(summary, indent=2))
+    return 130 if summary.get("interrupted") else 0
+
+
+def cmd_plot_curves(args) -> int:
+    from lbgp.viz.curves import plot_learning_curves
+
+    plot_learning_curves(args.run_dirs, args.out, labels=args.labels)
+    print(f"wrote {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="lbgp", description="Learning Based Goal Planning: a robot that walks in front of a person.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -58,6 +86,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
     p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
+    p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e"])
+    p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
+    p.add_argument("--no-curriculum", action="store_true", help="train on the final level from the start")
+    p.add_argument("--steps", type=int, default=None, help="environment steps in all (default 300000)")
+    p.add_argument("--minutes", type=float, default=None, help="also stop after this much wall time")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--actors", type=int, default=4, help="actor processes (one of them exploits)")
+    p.add_argument("--backend", default="processes", choices=["processes", "ray"])
+    p.add_argument("--out", help="run directory (created)")
+    p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its last checkpoint")
+    p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser("plot-curves", help="learning curves of runs (mean and half-std band over seeds)")
+    p.add_argument("run_dirs", nargs="+", help="run directories; runs with the same label are averaged")
+    p.add_argument("--out", required=True, help="output image (.png)")
+    p.add_argument("--labels", nargs="*", help="one label per run dir (default: method + curriculum from config)")
+    p.set_defaults(func=cmd_plot_curves)
     return parser
 
 

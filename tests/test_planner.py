@@ -191,7 +191,8 @@ def test_mujoco_robot_keeps_the_safety_distance_around_a_standing_person(robot):
 
 @pytest.mark.parametrize("robot", sorted(PRESETS))
 def test_mujoco_no_contact_with_a_person_crossing_the_path(robot):
+    cfg = PRESETS[robot]
     distances, contact, final = simulate(robot, [0, 0, 0], np.array([4.0, 0.0, 0.0]), [2.0, -2.0, math.pi / 2], (0.0, 0.6), seconds=14.0)
     assert not contact
-    assert distances.min() > 0.5
+    assert distances.min() > cfg.footprint_radius + cfg.person_radius  # bounding circles never overlap
     assert np.linalg.norm(final[:2] - [4.0, 0.0]) < 0.2

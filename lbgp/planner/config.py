@@ -40,10 +40,11 @@ class PlannerConfig:
     weight_clearance_slack: float = 1e3  # exact-penalty weight of a clearance violation (m)
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
     slowdown_factors: tuple = (0.7, 0.5, 0.3, 0.15)  # speed-limit scales tried when the person crosses the band
+    slowdown_horizon: float = 1.5  # s: only crossings this soon make the robot wait
     regularization: float = 1e-2  # proximal term of each SQP step
     # sequential QP
-    sqp_iterations: int = 1  # iterations when warm-started (real-time iteration: the band keeps
-    # improving from call to call, as in real-time-iteration MPC)
+    sqp_iterations: int = 2  # iterations when warm-started (the band also keeps improving from call
+    # to call, as in real-time-iteration MPC; 2 plans clearly better than 1 around a walking person)
     sqp_iterations_init: int = 6  # iterations after a (re)initialisation
     trust_region_position: float = 0.4  # m per iteration
     trust_region_heading: float = 0.8  # rad per iteration

@@ -35,7 +35,8 @@ robot is now, the call returns a safe stop with status ``infeasible``: the robot
 deeper into the person's safety radius (moving out of it, e.g. away from a person who walks
 towards the robot, is allowed).
 
-If the person's predicted path crosses the band at its time-optimal timing, the band is re-timed
+If the person's predicted path crosses the band within the next ``slowdown_horizon`` seconds at
+its time-optimal timing, the band is re-timed
 slower (``slowdown_factors`` of the speed limits) until it clears: the robot waits for the person
 to pass rather than racing them. The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
 limits over one control period, so the hard limits hold even when the band is only approximately
@@ -137,14 +138,15 @@ class TebPlanner:
         self._band = None
         self._goal = None
 
-    def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_speed: float = 0.0) -> Plan:
+    def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0)) -> Plan:
         """One planner call.
 
-        ``goal`` is (x, y) or (x, y, yaw) in the world; its yaw defaults to the person's heading.
-        ``person_velocity`` is the person's world (vx, vy). ``goal_speed`` is the speed to arrive
-        with (0 = stop at the goal; a goal carried along by a walking person keeps moving, so its
-        controller passes the person's speed). Never raises on bad numbers: returns a safe-stop
-        plan whose status says why.
+        ``goal`` is (x, y) or (x, y, yaw) in the world now; its yaw defaults to the person's
+        heading. ``person_velocity`` is the person's world (vx, vy). ``goal_velocity`` is the goal's
+        world (vx, vy): a goal carried along by a walking person moves with it, so the band ends
+        where the goal will be when the robot gets there and arrives with the goal's speed
+        ((0, 0): a fixed goal, stop there). Never raises on bad numbers: returns a safe-stop plan
+        whose status says why.
         """
         t_start = time.perf_counter()
         cfg = self.cfg
@@ -157,10 +159,10 @@ class TebPlanner:
             if goal.size == 2:
                 goal = np.array([goal[0], goal[1], person_pose[2]])
             goal = goal.reshape(3)
-            goal_speed = float(goal_speed)
+            goal_vel = np.asarray(goal_velocity, dtype=float).reshape(2)
         except (TypeError, ValueError):
             return self._stop(0.0, 0.0, INVALID_INPUT, t_start)
-        values = np.concatenate([robot_pose, [v_now, w_now, goal_speed], person_pose, person_vel, goal])
+        values = np.concatenate([robot_pose, [v_now, w_now], goal_vel, person_pose, person_vel, goal])
         if not np.all(np.isfinite(values)):
             return self._stop(v_now, w_now, INVALID_INPUT, t_start)
         if np.linalg.norm(goal[:2] - person_pose[:2]) < cfg.safety_distance:
@@ -168,16 +170,22 @@ class TebPlanner:
             return self._stop(v_now, w_now, GOAL_IN_COLLISION, t_start)
 
         warm = self._band is not None and np.linalg.norm(goal[:2] - self._goal[:2]) <= cfg.reinit_goal_jump
+        goal_speed = float(np.hypot(*goal_vel))
         if warm:
             band = shifted_band(self._band, robot_pose, cfg.dt_min)
         else:
-            band = initial_band(robot_pose, goal, person_pose[:2], cfg.safety_distance + 0.1, self.N)
+            # aim the first band where the goal will be after a rough travel-time estimate
+            closing = max(cfg.max_vel_x - goal_speed, 0.2 * cfg.max_vel_x)
+            eta = min(np.linalg.norm(goal[:2] - robot_pose[:2]) / closing, 5.0)
+            ahead = np.r_[goal[:2] + goal_vel * eta, goal[2]]
+            band = initial_band(robot_pose, ahead, person_pose[:2], cfg.safety_distance + 0.1, self.N)
         iterations = cfg.sqp_iterations if warm else cfg.sqp_iterations_init
         scale = float(np.linalg.norm(goal[:2] - robot_pose[:2])) + 1.0
         status, done = OK, 0
         for done in range(1, iterations + 1):
             band.dt = self._timing(band, v_now, w_now, goal_speed)
-            step, status = self._sqp_step(band, goal, person_pose[:2], person_vel)
+            goal_then = np.r_[goal[:2] + goal_vel * band.times[-1], goal[2]]
+            step, status = self._sqp_step(band, goal_then, person_pose[:2], person_vel)
             if status != OK:
                 break
             step[[self.ix[0], self.iy[0], self.ith[0]]] = 0.0  # exact, not just to OSQP's tolerance
@@ -194,13 +202,17 @@ class TebPlanner:
             return self._stop(v_now, w_now, status, t_start, band, person_pose[:2], person_vel, done)
         band.dt = self._timing(band, v_now, w_now, goal_speed)
         clearance = self._clearance(band, person_pose[:2], person_vel)
-        if clearance[1:].min() < cfg.safety_distance - cfg.clearance_tolerance:
-            # the person would cross the band while we drive it: wait for them by driving it slower
+        near = band.times <= cfg.slowdown_horizon
+        near[0] = False
+        if near.any() and clearance[near].min() < cfg.safety_distance - cfg.clearance_tolerance:
+            # the person would cross the band soon while we drive it: wait for them, drive it slower
             for slower in cfg.slowdown_factors:
-                dt = self._timing(band, v_now, w_now, goal_speed, speed_scale=slower)
-                c = self._clearance(Band(band.poses, dt), person_pose[:2], person_vel)
-                if c[1:].min() >= cfg.safety_distance - cfg.clearance_tolerance:
-                    band.dt, clearance = dt, c
+                timed = Band(band.poses, self._timing(band, v_now, w_now, goal_speed, speed_scale=slower))
+                c = self._clearance(timed, person_pose[:2], person_vel)
+                near = timed.times <= cfg.slowdown_horizon
+                near[0] = False
+                if not near.any() or c[near].min() >= cfg.safety_distance - cfg.clearance_tolerance:
+                    band.dt, clearance = timed.dt, c
                     break
         if clearance[1] < cfg.safety_distance - cfg.clearance_tolerance and clearance[1] < clearance[0]:
             self._forget_band()

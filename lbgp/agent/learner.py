@@ -1,0 +1,72 @@
+"""The D4PG learner: distributional critic, deterministic actor, n-step targets, target networks."""
+
+from __future__ import annotations
+
+import copy
+
+import torch
+import torch.nn.functional as F
+
+from lbgp.agent.config import D4PGConfig
+from lbgp.agent.distributional import categorical_projection
+from lbgp.agent.networks import Actor, DistributionalCritic
+
+
+class D4PGLearner:
+    def __init__(self, cfg: D4PGConfig, obs_size: int, action_size: int):
+        self.cfg = cfg
+        self.actor = Actor(obs_size, action_size, cfg.hidden)
+        self.critic = DistributionalCritic(obs_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden)
+        self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
+        self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)
+        self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
+        self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
+        self.updates = 0
+
+    def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
+        obs, action = batch["obs"], batch["action"]
+        # critic: cross-entropy to the projected n-step target distribution
+        with torch.no_grad():
+            next_action = self.target_actor(batch["next_obs"])
+            next_probs = torch.softmax(self.target_critic(batch["next_obs"], next_action), dim=-1)
+            target = categorical_projection(next_probs, batch["ret"], batch["discount"], self.critic.atoms)
+        logits = self.critic(obs, action)
+        critic_loss = -(target * F.log_softmax(logits, dim=-1)).sum(-1).mean()
+        self.critic_opt.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        torch.nn.utils.clip_grad_norm_(self.critic.parameters(), self.cfg.grad_clip)
+        self.critic_opt.step()
+
+        # actor: deterministic policy gradient through the critic's expected value
+        q = self.critic.q_value(obs, self.actor(obs))
+        actor_loss = -q.mean()
+        self.actor_opt.zero_grad(set_to_none=True)
+        actor_loss.backward()
+        torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
+        self.actor_opt.step()
+
+        self.updates += 1
+        if self.updates % self.cfg.target_update_period == 0:
+            self.target_actor.load_state_dict(self.actor.state_dict())
+            self.target_critic.load_state_dict(self.critic.state_dict())
+        return {"critic_loss": float(critic_loss.detach()), "actor_loss": float(actor_loss.detach()), "q": float(q.detach().mean())}
+
+    def state_dict(self) -> dict:
+        return {
+            "actor": self.actor.state_dict(),
+            "critic": self.critic.state_dict(),
+            "target_actor": self.target_actor.state_dict(),
+            "target_critic": self.target_critic.state_dict(),
+            "actor_opt": self.actor_opt.state_dict(),
+            "critic_opt": self.critic_opt.state_dict(),
+            "updates": torch.tensor(self.updates),
+        }
+
+    def load_state_dict(self, state: dict) -> None:
+        self.actor.load_state_dict(state["actor"])
+        self.critic.load_state_dict(state["critic"])
+        self.target_actor.load_state_dict(state["target_actor"])
+        self.target_critic.load_state_dict(state["target_critic"])
+        self.actor_opt.load_state_dict(state["actor_opt"])
+        self.critic_opt.load_state_dict(state["critic_opt"])
+        self.updates = int(state["updates"])

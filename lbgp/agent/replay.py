@@ -1,0 +1,52 @@
+"""Uniform replay of n-step transitions (a ring buffer of numpy arrays)."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+FIELDS = ("obs", "action", "ret", "discount", "next_obs")
+
+
+class ReplayBuffer:
+    def __init__(self, capacity: int, obs_size: int, action_size: int):
+        self.capacity = int(capacity)
+        self.obs = np.zeros((capacity, obs_size), np.float32)
+        self.action = np.zeros((capacity, action_size), np.float32)
+        self.ret = np.zeros(capacity, np.float32)
+        self.discount = np.zeros(capacity, np.float32)
+        self.next_obs = np.zeros((capacity, obs_size), np.float32)
+        self.size = 0
+        self.cursor = 0
+
+    def __len__(self) -> int:
+        return self.size
+
+    def add_batch(self, obs, action, ret, discount, next_obs) -> None:
+        n = len(ret)
+        idx = (self.cursor + np.arange(n)) % self.capacity
+        self.obs[idx], self.action[idx], self.ret[idx] = obs, action, ret
+        self.discount[idx], self.next_obs[idx] = discount, next_obs
+        self.cursor = int((self.cursor + n) % self.capacity)
+        self.size = int(min(self.size + n, self.capacity))
+
+    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
+        if self.size == 0:
+            raise ValueError("cannot sample from an empty replay buffer")
+        idx = rng.integers(0, self.size, batch_size)
+        return {f: torch.from_numpy(getattr(self, f)[idx]) for f in FIELDS}
+
+    # -- checkpointing (tensors only, so that torch.load(weights_only=True) can read it)
+    def state_dict(self) -> dict:
+        n = self.size
+        order = np.arange(n) if n < self.capacity else (self.cursor + np.arange(n)) % self.capacity
+        return {f: torch.from_numpy(getattr(self, f)[order].copy()) for f in FIELDS}
+
+    def load_state_dict(self, state: dict) -> None:
+        n = len(state["ret"])
+        if n > self.capacity:
+            state = {f: v[-self.capacity :] for f, v in state.items()}
+            n = self.capacity
+        self.size, self.cursor = 0, 0
+        if n:
+            self.add_batch(*(state[f].numpy() for f in FIELDS))

@@ -11,16 +11,20 @@ calls. The ratio (1)/(3) is the share of the raw physics rate that the task laye
 from __future__ import annotations
 
 import argparse
-import json
 import os
+import sys
 import platform
 import time
+from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from lbgp.actions import action_from_goal
-from lbgp.sim import make_env
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import write_result  # noqa: E402
+
+from lbgp.actions import action_from_goal  # noqa: E402
+from lbgp.sim import make_env  # noqa: E402
 
 
 def rate(fn, seconds: float) -> float:
@@ -86,10 +90,7 @@ def main() -> None:
         "machine": {"cpu_count": os.cpu_count(), "python": platform.python_version(), "mujoco": mujoco.__version__},
         "robots": {robot: bench_robot(robot, args.seconds) for robot in ("jackal", "turtlebot2")},
     }
-    os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
-    with open(args.json, "w") as f:
-        json.dump(result, f, indent=2)
-    print(json.dumps(result, indent=2))
+    write_result(args.json, result)
 
 
 if __name__ == "__main__":

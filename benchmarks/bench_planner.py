@@ -12,15 +12,19 @@ process, two planner calls per agent step).
 from __future__ import annotations
 
 import argparse
-import json
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from lbgp.actions import action_from_goal
-from lbgp.planner import planner_config_for
-from lbgp.sim import make_env, scenario_names
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import write_result  # noqa: E402
+
+from lbgp.actions import action_from_goal  # noqa: E402
+from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.sim import make_env, scenario_names  # noqa: E402
 
 
 def bench(robot: str, n_poses: int, calls: int) -> dict:
@@ -69,10 +73,7 @@ def main() -> None:
     result = {
         f"{robot}_N{n}": bench(robot, n, args.calls) for robot in ("jackal", "turtlebot2") for n in (20, 30)
     }
-    os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
-    with open(args.json, "w") as f:
-        json.dump(result, f, indent=2)
-    print(json.dumps(result, indent=2))
+    write_result(args.json, result)
 
 
 if __name__ == "__main__":

@@ -28,6 +28,13 @@ def _print_table(rows: list[dict]) -> None:
         )
 
 
+PRETRAINED = Path(__file__).resolve().parent / "agent" / "pretrained"
+
+
+def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:
+    return PRETRAINED / f"{method}_{robot}.pt"
+
+
 def cmd_demo(args) -> int:
     from lbgp.rollout import ConstantGoalPolicy, run_episode
     from lbgp.sim import make_env
@@ -35,7 +42,17 @@ def cmd_demo(args) -> int:
     from lbgp.viz.recording import EpisodeRecorder
 
     out = Path(args.out)
-    policy, policy_name = ConstantGoalPolicy((1.5, 0.0)), "scripted goal 1.5 m ahead of the person"
+    policy_file = Path(args.policy) if args.policy else default_policy_path()
+    if args.scripted:
+        policy, policy_name = ConstantGoalPolicy((1.5, 0.0)), "scripted goal 1.5 m ahead of the person"
+    elif policy_file.is_file():
+        from lbgp.agent import load_policy
+
+        policy, policy_name = load_policy(policy_file), f"{policy_file}"
+    elif args.policy:
+        raise FileNotFoundError(f"{policy_file}: no such policy file")
+    else:
+        policy, policy_name = ConstantGoalPolicy((1.5, 0.0)), "scripted goal 1.5 m ahead of the person (no pretrained policy found)"
     print(f"lbgp demo: robot={args.robot} seed={args.seed} policy: {policy_name}")
     rows = []
     with EpisodeRecorder(out / "demo.rrd") as recorder:
@@ -46,6 +63,47 @@ def cmd_demo(args) -> int:
     summary = {"robot": args.robot, "seed": args.seed, "policy": policy_name, "episodes": rows}
     _write_json_atomic(out / "summary.json", summary)
     print(f"wrote {out / 'demo.rrd'} (open with: rerun {out / 'demo.rrd'}) and {out / 'summary.json'}")
+    return 0
+
+
+def cmd_evaluate(args) -> int:
+    from lbgp.evaluate import evaluate, resolve_names
+
+    if args.method in ("lbgp", "e2e"):
+        from lbgp.agent import load_policy
+
+        path = Path(args.policy) if args.policy else default_policy_path(args.method)
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such policy file")
+        policy = load_policy(path)
+        if policy.method != args.method:
+            raise ValueError(f"{path} holds a {policy.method} policy, not {args.method}")
+    elif args.method == "hc":
+        from lbgp.baselines.hc import HCPolicy
+
+        policy = HCPolicy(distance=args.hc_distance, horizon=args.hc_horizon)
+    else:
+        from lbgp.rollout import ConstantGoalPolicy
+
+        policy = ConstantGoalPolicy((1.5, 0.0))
+    names = resolve_names(args.scenario)
+    recorder = None
+    if args.record:
+        from lbgp.viz.recording import EpisodeRecorder
+
+        recorder = EpisodeRecorder(args.record)
+    try:
+        results = evaluate(policy, args.method, names, robot=args.robot, episodes=args.episodes, seed=args.seed,
+                           recorder=recorder, person_path=args.person_path)
+    finally:
+        if recorder is not None:
+            recorder.close()
+    print(f"{'scenario':<18}{'D mean+-std':>14}{'alpha mean+-std':>18}{'reward':>9}{'coll':>6}{'early':>6}{'steps':>7}")
+    for r in results:
+        print(f"{r['scenario']:<18}{r['distance_mean']:>7.2f}+-{r['distance_std']:<5.2f}{r['alpha_mean_deg']:>9.1f}+-{r['alpha_std_deg']:<6.1f}"
+              f"{r['reward']:>9.2f}{r['collisions']:>6d}{r['terminated_early']:>6d}{r['steps']:>7.1f}")
+    if args.json:
+        _write_json_atomic(Path(args.json), results)
     return 0
 
 
@@ -85,7 +143,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
+    p.add_argument("--policy", help="policy file (default: the shipped pretrained LBGP policy for the Jackal)")
+    p.add_argument("--scripted", action="store_true", help="use the scripted goal 1.5 m ahead instead of a policy")
     p.set_defaults(func=cmd_demo)
+
+    p = sub.add_parser("evaluate", help="seeded episodes of a method on levels or scenarios; metrics table and JSON")
+    p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])
+    p.add_argument("--policy", help="policy file (default: the shipped pretrained one for the method)")
+    p.add_argument("--hc-distance", type=float, default=1.5, help="HC: goal distance ahead of the predicted person (m)")
+    p.add_argument("--hc-horizon", type=float, default=1.0, help="HC: prediction horizon (s)")
+    p.add_argument("--scenario", default="all", help="all (paper scenarios), levels, or comma-separated names")
+    p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
+    p.add_argument("--episodes", type=int, default=10)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--person-path", help="CSV of x,y waypoints for the person (replaces the scenario's motion)")
+    p.add_argument("--json", help="write the metrics here")
+    p.add_argument("--record", help="write a rerun recording (.rrd) of every episode")
+    p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e"])

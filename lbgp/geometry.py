@@ -51,8 +51,11 @@ def from_frame(pose, frame) -> np.ndarray:
 
 def distance_and_alpha(robot_pose, person_pose) -> tuple[float, float]:
     """D (m) and alpha (rad, 0 = robot straight in front of the person, + = to the person's left)."""
-    rel = to_frame(robot_pose, person_pose)
-    return float(math.hypot(rel[0], rel[1])), float(math.atan2(rel[1], rel[0]))
+    dx = float(robot_pose[0]) - float(person_pose[0])
+    dy = float(robot_pose[1]) - float(person_pose[1])
+    c, s = math.cos(float(person_pose[2])), math.sin(float(person_pose[2]))
+    x, y = c * dx + s * dy, -s * dx + c * dy  # the robot in the person frame
+    return math.hypot(x, y), math.atan2(y, x)
 
 
 def pose_from_polar(person_pose, distance: float, alpha: float, relative_yaw: float = 0.0) -> np.ndarray:

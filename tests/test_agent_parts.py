@@ -121,6 +121,14 @@ def test_curriculum_advances_on_threshold_and_on_budget():
     assert c.history == [(0, "straight"), (20, "circles"), (520, "smoothed")]
 
 
+def test_curriculum_advances_on_its_share_of_the_time_limit():
+    c = Curriculum(True, (1e9, 1e9, 1e9), (0.1, 0.2, 0.3), total_steps=10**9, window=3, time_limit_s=100.0)
+    assert not c.record("straight", 0.0, 10, wall_time=9.0)
+    assert c.record("straight", 0.0, 20, wall_time=10.5) and c.level == "circles"
+    assert not c.record("circles", 0.0, 30, wall_time=30.0)
+    assert c.record("circles", 0.0, 40, wall_time=30.6) and c.level == "smoothed"  # 20 s after 10.5
+
+
 def test_curriculum_ignores_returns_from_other_levels_and_without_curriculum_starts_at_the_end():
     c = Curriculum(True, (1.0, 1.0, 1.0), (1.0, 1.0, 1.0), 10**6, window=2)
     for _ in range(5):

@@ -64,10 +64,17 @@ def test_kill_mid_run_then_resume_continues_from_the_checkpoint(tmp_path):
     else:
         proc.kill()
         pytest.fail("no checkpoint with learner updates appeared: " + (tmp_path / "train.log").read_text()[-3000:])
+    import psutil
+
+    actors = psutil.Process(proc.pid).children(recursive=True)
+    assert actors, "the learner runs its actors as child processes"
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)
-    for child in ("lbgp-actor",):
-        subprocess.run(["pkill", "-9", "-f", child], check=False)
+    # the actors notice that their learner died and exit instead of lingering as orphans
+    gone, alive = psutil.wait_procs(actors, timeout=60)
+    for p in alive:
+        p.kill()
+    assert not [p for p in alive if p.name().startswith("python")], "actor processes outlived their learner"
 
     saved = torch.load(ckpt, weights_only=True)  # the state the resume must start from
     # rows written after the checkpoint are dropped on resume; none is corrupted
@@ -117,3 +124,11 @@ def test_plot_curves(tmp_path):
     assert (tmp_path / "curves.png").stat().st_size > 5000
     with pytest.raises(ValueError, match="not a training run directory"):
         plot_learning_curves([tmp_path], tmp_path / "x.png")
+
+
+def test_ray_backend_trains_where_ray_is_installed(tmp_path):
+    pytest.importorskip("ray")
+    cfg = D4PGConfig(**TINY, seed=4)
+    summary = train(cfg, tmp_path / "run", backend="ray", progress=False)
+    assert summary["env_steps"] >= 300 and summary["learner_updates"] > 0
+    assert load_policy(tmp_path / "run" / "policy.pt").act(np.zeros(57, np.float32)).shape == (2,)

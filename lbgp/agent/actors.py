@@ -3,13 +3,15 @@
 Weights travel through one shared float32 array plus a version counter (the learner writes, the
 actors copy when the version changed); experience and episode results travel through one queue.
 Each actor process runs torch with one thread, so the learner and the actors share the cores
-without oversubscribing them.
+without oversubscribing them, and at a lower scheduling priority (``actor_niceness``), so that on a
+small machine the learner keeps about one core and the actors share the rest.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import multiprocessing as mp
+import os
 
 import numpy as np
 import torch
@@ -69,9 +71,14 @@ class ActorSpec:
 def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, queue, stop) -> None:
     """The actor loop (runs in its own process until ``stop`` is set)."""
     torch.set_num_threads(1)
+    if cfg_dict.get("actor_niceness"):
+        os.nice(int(cfg_dict["actor_niceness"]))  # the learner gets the CPU it needs first
     from lbgp.sim import make_env
 
     cfg = D4PGConfig.from_dict(cfg_dict)
+    if hasattr(queue, "cancel_join_thread"):
+        queue.cancel_join_thread()  # never hang at exit on a queue nobody reads any more
+    parent = mp.parent_process()
     rng = np.random.default_rng(spec.seed)
     actor = Actor(obs_lib.SIZE, ACTION_SIZE, cfg.hidden)
     version = -1
@@ -79,6 +86,8 @@ def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, 
     nstep = NStepAccumulator(cfg.n_step, cfg.discount)
     try:
         while not stop.is_set():
+            if parent is not None and not parent.is_alive():
+                return  # the learner died (e.g. killed): do not linger as an orphan
             version, flat = board.fetch(version)
             if flat is not None:
                 load_flat_parameters(actor, flat)
@@ -115,7 +124,8 @@ def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, 
     except KeyboardInterrupt:  # the learner handles Ctrl-C; actors just stop
         pass
     finally:
-        queue.put(("exit", spec.actor_id))
+        if parent is None or parent.is_alive():
+            queue.put(("exit", spec.actor_id))
 
 
 def actor_specs(cfg: D4PGConfig, restart: int = 0) -> list[ActorSpec]:
@@ -172,19 +182,25 @@ class ProcessActors:
 
     def stop(self, timeout: float = 20.0) -> list:
         """Stop the actors; returns the messages still in flight (so that the queue is drained)."""
-        import time
-
         self.stop_event.set()
-        leftover, exited = [], set()
-        deadline = time.monotonic() + timeout
-        while len(exited) < len(self.procs) and time.monotonic() < deadline:
-            for msg in self.poll(timeout=0.2):
-                if msg[0] == "exit":
-                    exited.add(msg[1])
-                else:
-                    leftover.append(msg)
+        leftover = drain_until_exited(self.poll, len(self.procs), timeout)
         for p in self.procs:
             p.join(timeout=2.0)
             if p.is_alive():
                 p.terminate()
         return leftover
+
+
+def drain_until_exited(poll, count: int, timeout: float) -> list:
+    """Read messages until ``count`` actors said "exit" (or ``timeout``); returns the others."""
+    import time
+
+    leftover, exited = [], set()
+    deadline = time.monotonic() + timeout
+    while len(exited) < count and time.monotonic() < deadline:
+        for msg in poll(timeout=0.2):
+            if msg[0] == "exit":
+                exited.add(msg[1])
+            else:
+                leftover.append(msg)
+    return leftover

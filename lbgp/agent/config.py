@@ -29,6 +29,7 @@ class D4PGConfig:
     sigma: float = 0.3  # Gaussian exploration noise on the [-1, 1] action (acme)
     weight_sync_steps: int = 200  # actors fetch fresh weights at least this often (agent steps)
     earlier_level_share: float = 0.2  # share of exploring episodes on an earlier curriculum level
+    actor_niceness: int = 10  # actors run at lower priority: the learner keeps ~1 core on a 2-core box
 
     # --- learner
     n_step: int = 5  # (acme)
@@ -48,7 +49,8 @@ class D4PGConfig:
 
     # --- curriculum (see lbgp/agent/curriculum.py)
     level_thresholds: tuple = (15.0, 12.0, 8.0)  # exploit return (mean over the window) to advance
-    level_budget_fraction: tuple = (0.15, 0.2, 0.25)  # ... or after this share of total_steps per level
+    level_budget_fraction: tuple = (0.15, 0.2, 0.25)  # ... or after this share of total_steps (and of
+    # time_limit_s, if set) per level; the rest goes to the final level
     curriculum_window: int = 10  # exploit episodes averaged
 
     # --- files

@@ -75,7 +75,8 @@ class Trainer:
         self.rng = np.random.default_rng(cfg.seed)
         self.learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
         self.replay = ReplayBuffer(cfg.replay_capacity, obs_lib.SIZE, 2)
-        self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps, cfg.curriculum_window)
+        self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps,
+                                     cfg.curriculum_window, cfg.time_limit_s)
         self.env_steps = 0
         self.episodes = 0
         self.wall_time = 0.0
@@ -161,7 +162,7 @@ class Trainer:
         if not exploring:
             curve_writer.writerow([self.env_steps, f"{self.wall_time:.2f}", level, f"{ret:.4f}"])
             self.recent_exploit = (self.recent_exploit + [ret])[-10:]
-            if self.curriculum.record(level, ret, self.env_steps):
+            if self.curriculum.record(level, ret, self.env_steps, self.wall_time):
                 self.level_times[self.curriculum.level] = self.wall_time
 
     def run(self) -> dict:
@@ -169,6 +170,7 @@ class Trainer:
         actors = self._make_actors()
         actors.board.publish(flat_parameters(self.learner.actor))
         actors.set_level(self.curriculum.index)
+        published_level = self.curriculum.index
         self.level_times.setdefault(self.curriculum.level, self.wall_time)
         previous = signal.signal(signal.SIGTERM, self._on_sigterm)
         bar = None
@@ -191,8 +193,9 @@ class Trainer:
                     for msg in actors.poll(timeout=0.0 if can_learn else 0.2):
                         self._handle(msg, curve)
                     curve_file.flush()
-                    if self.curriculum.index != int(actors.level_index.value):
+                    if self.curriculum.index != published_level:
                         actors.set_level(self.curriculum.index)
+                        published_level = self.curriculum.index
                     if can_learn:
                         for _ in range(10):
                             self.learner.update(self.replay.sample(cfg.batch_size, self.rng))

@@ -55,12 +55,28 @@ class Physics(dm_mujoco.Physics):
         self.contact_pair = np.outer(robot_geoms, person_geoms) | np.outer(person_geoms, robot_geoms)
         self.drive = spec.drive
         self._raw_model, self._raw_data = model, self.data.ptr
+        self._pose_cache, self._pose_time = None, None
+        # how far (horizontally) any robot / person collision geom reaches from its body's centre;
+        # beyond the sum of both no contact is possible, and the contact scan is skipped
+        data = self._raw_data
+        mujoco.mj_forward(model, data)
+
+        def reach(body, geoms):
+            ids = np.flatnonzero(geoms)
+            offsets = np.linalg.norm(data.geom_xpos[ids, :2] - data.xpos[body, :2], axis=1)
+            return float(np.max(offsets + model.geom_rbound[ids]))
+
+        self.contact_range = reach(self.robot_body, robot_geoms) + reach(person, person_geoms) + 0.05
 
     # -- robot
     def robot_pose(self) -> np.ndarray:
-        q = self._raw_data.qpos[self.qpos_adr : self.qpos_adr + 7]
+        data = self._raw_data
+        if self._pose_time == data.time and self._pose_cache is not None:
+            return self._pose_cache.copy()  # already computed for this physics state
+        q = data.qpos[self.qpos_adr : self.qpos_adr + 7]
         yaw = math.atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] ** 2 + q[6] ** 2))
-        return np.array([q[0], q[1], yaw])
+        self._pose_cache, self._pose_time = np.array([q[0], q[1], yaw]), data.time
+        return self._pose_cache.copy()
 
     def robot_velocity(self) -> np.ndarray:
         """(v, w): forward speed in the robot frame and yaw rate."""
@@ -70,6 +86,7 @@ class Physics(dm_mujoco.Physics):
 
     def set_robot_pose(self, pose) -> None:
         x, y, yaw = (float(p) for p in pose)
+        self._pose_cache = None
         adr = self.qpos_adr
         z = self.model.body_pos[self.robot_body][2]
         self.data.qpos[adr : adr + 7] = [x, y, z, math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
@@ -99,14 +116,12 @@ class Physics(dm_mujoco.Physics):
         data = self._raw_data
         if data.ncon == 0:
             return False
+        robot = self.robot_pose()
+        person = data.mocap_pos[self.mocap_id]
+        if math.hypot(robot[0] - person[0], robot[1] - person[1]) > self.contact_range:
+            return False
         geoms = data.contact.geom
         return bool(self.contact_pair[geoms[:, 0], geoms[:, 1]].any())
-
-    def warnings(self) -> dict[str, int]:
-        """MuJoCo warnings raised so far (name -> count), e.g. to check a model is stable."""
-        import mujoco
-
-        return {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(self.data.warning) if w.number}
 
 
 def load_physics(spec: RobotSpec) -> Physics:

@@ -1,0 +1,1 @@
+"""Baselines of the paper: HC (EKF person prediction + goal ahead + the same planner)."""

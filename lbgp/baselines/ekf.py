@@ -1,0 +1,88 @@
+"""Extended Kalman filter for a walking person, constant turn rate and velocity (CTRV) model.
+
+State ``s = (x, y, theta, v, omega)``; measurements are poses ``(x, y, theta)`` (e.g. from motion
+capture or a detector). ``update(None)`` is a dropped measurement: the filter only predicts.
+With ``omega`` held at zero (``turn_rate=False``) it is the constant-velocity model.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from lbgp.geometry import wrap_angle
+
+
+def ctrv(state: np.ndarray, dt: float) -> np.ndarray:
+    x, y, th, v, w = state
+    if abs(w) > 1e-6:
+        x2 = x + v / w * (math.sin(th + w * dt) - math.sin(th))
+        y2 = y - v / w * (math.cos(th + w * dt) - math.cos(th))
+    else:
+        x2 = x + v * dt * math.cos(th)
+        y2 = y + v * dt * math.sin(th)
+    return np.array([x2, y2, th + w * dt, v, w])
+
+
+def ctrv_jacobian(state: np.ndarray, dt: float) -> np.ndarray:
+    """d ctrv / d state, by central differences (5x5, cheap and exact enough for filtering)."""
+    J = np.zeros((5, 5))
+    for i in range(5):
+        h = 1e-6 * max(1.0, abs(state[i]))
+        d = np.zeros(5)
+        d[i] = h
+        J[:, i] = (ctrv(state + d, dt) - ctrv(state - d, dt)) / (2 * h)
+    return J
+
+
+class PersonEKF:
+    def __init__(self, pos_std: float = 0.05, yaw_std: float = 0.05, acc_std: float = 0.5, yaw_acc_std: float = 0.5, turn_rate: bool = True):
+        self.R = np.diag([pos_std**2, pos_std**2, yaw_std**2])
+        self.acc_std, self.yaw_acc_std = acc_std, yaw_acc_std
+        self.turn_rate = turn_rate
+        self.H = np.hstack([np.eye(3), np.zeros((3, 2))])
+        self.state: np.ndarray | None = None
+        self.P = np.eye(5)
+
+    def reset(self, pose) -> None:
+        self.state = np.array([pose[0], pose[1], pose[2], 0.0, 0.0], dtype=float)
+        self.P = np.diag([self.R[0, 0], self.R[1, 1], self.R[2, 2], 1.0, 1.0])
+
+    def predict(self, dt: float) -> None:
+        F = ctrv_jacobian(self.state, dt)
+        self.state = ctrv(self.state, dt)
+        G = np.array([[0.5 * dt**2 * math.cos(self.state[2]), 0.0], [0.5 * dt**2 * math.sin(self.state[2]), 0.0],
+                      [0.0, 0.5 * dt**2], [dt, 0.0], [0.0, dt]])
+        Q = G @ np.diag([self.acc_std**2, self.yaw_acc_std**2]) @ G.T
+        self.P = F @ self.P @ F.T + Q
+        if not self.turn_rate:
+            self.state[4] = 0.0
+            self.P[4, :] = self.P[:, 4] = 0.0
+
+    def update(self, pose) -> None:
+        """Fuse a measured pose; ``None`` (a dropped frame) or a non-finite pose is skipped."""
+        if pose is None or not np.all(np.isfinite(pose)):
+            return
+        innovation = np.asarray(pose, dtype=float) - self.state[:3]
+        innovation[2] = wrap_angle(innovation[2])
+        S = self.H @ self.P @ self.H.T + self.R
+        K = self.P @ self.H.T @ np.linalg.inv(S)
+        self.state = self.state + K @ innovation
+        self.state[2] = wrap_angle(self.state[2])
+        self.P = (np.eye(5) - K @ self.H) @ self.P
+
+    def step(self, pose, dt: float) -> np.ndarray:
+        """Predict ``dt`` then fuse ``pose`` (or start the filter on the first pose)."""
+        if self.state is None:
+            if pose is None:
+                raise ValueError("the first measurement of a track cannot be missing")
+            self.reset(pose)
+        else:
+            self.predict(dt)
+            self.update(pose)
+        return self.state.copy()
+
+    def forecast(self, horizon: float) -> np.ndarray:
+        """The pose predicted ``horizon`` seconds ahead (no update)."""
+        return ctrv(self.state, horizon)[:3]

@@ -1,0 +1,37 @@
+"""Seeded, viewer-free evaluation of a policy over levels or scenarios.
+
+The JSON written by ``lbgp evaluate --json`` is a list with one entry per scenario:
+``scenario, method, distance_mean, distance_std (m), alpha_mean_deg, alpha_std_deg, reward (mean
+accumulated reward per episode), reward_std, collisions, terminated_early (episode counts),
+steps (mean episode length), episodes``.
+"""
+
+from __future__ import annotations
+
+from lbgp.metrics import aggregate
+from lbgp.rollout import run_episode
+from lbgp.sim import make_env
+from lbgp.sim.tasks import LEVELS, SCENARIOS
+
+
+def resolve_names(spec: str) -> list[str]:
+    """'all' -> every paper scenario, 'levels' -> every curriculum level, else a comma list."""
+    if spec == "all":
+        return list(SCENARIOS)
+    if spec == "levels":
+        return list(LEVELS)
+    names = [n.strip() for n in spec.split(",") if n.strip()]
+    unknown = [n for n in names if n not in SCENARIOS and n not in LEVELS]
+    if unknown or not names:
+        raise ValueError(f"unknown scenario {', '.join(map(repr, unknown)) or repr(spec)}; use all, levels, or names from: {', '.join(list(LEVELS) + list(SCENARIOS))}")
+    return names
+
+
+def evaluate(policy, method: str, names: list[str], robot: str = "jackal", episodes: int = 10, seed: int = 0,
+             recorder=None, person_path=None, horizon: int = 35) -> list[dict]:
+    results = []
+    for k, name in enumerate(names):
+        env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path, horizon=horizon)
+        runs = [run_episode(env, policy, recorder, episode_index=i) for i in range(episodes)]
+        results.append({"scenario": name, "method": method, **aggregate(runs)})
+    return results

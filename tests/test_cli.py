@@ -1,0 +1,67 @@
+"""The command line: help, errors, the demo (with the shipped policy and scripted)."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from lbgp.cli import default_policy_path, main
+from lbgp.viz.recording import ENTITY_PATHS, entity_paths_in
+
+
+def test_help_lists_the_subcommands(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--help"])
+    assert exit_info.value.code == 0
+    out = capsys.readouterr().out
+    for cmd in ("demo", "train", "plot-curves"):
+        assert cmd in out
+
+
+def test_unknown_option_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["demo", "--frobnicate"])
+    assert exit_info.value.code == 2
+    assert "unrecognized arguments: --frobnicate" in capsys.readouterr().err
+
+
+def test_missing_policy_file_is_a_clear_error(tmp_path, capsys):
+    assert main(["demo", "--policy", str(tmp_path / "nope.pt"), "--out", str(tmp_path)]) == 2
+    assert "no such policy file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("scripted", [False, True])
+def test_demo_writes_a_recording_and_a_summary(tmp_path, scripted):
+    args = ["demo", "--out", str(tmp_path)] + (["--scripted"] if scripted else [])
+    assert main(args) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert [e["setting"] for e in summary["episodes"]] == ["straight", "circles", "smoothed", "trajectories"]
+    if not scripted and default_policy_path().is_file():
+        assert summary["policy"].endswith("lbgp_jackal.pt")
+    paths = entity_paths_in(tmp_path / "demo.rrd")
+    assert set(ENTITY_PATHS) <= paths, set(ENTITY_PATHS) - paths
+
+
+def test_console_script_entry_point_runs():
+    out = subprocess.run([sys.executable, "-m", "lbgp.cli", "--help"], capture_output=True, text=True)
+    assert out.returncode == 0 and "demo" in out.stdout
+
+
+def test_evaluate_writes_the_documented_json(tmp_path):
+    out = tmp_path / "m.json"
+    rrd = tmp_path / "e.rrd"
+    assert main(["evaluate", "--method", "hc", "--scenario", "straight_ahead,turning_inside", "--episodes", "1",
+                 "--json", str(out), "--record", str(rrd)]) == 0
+    rows = json.loads(out.read_text())
+    assert [r["scenario"] for r in rows] == ["straight_ahead", "turning_inside"]
+    keys = {"scenario", "method", "distance_mean", "distance_std", "alpha_mean_deg", "alpha_std_deg", "reward",
+            "collisions", "terminated_early", "steps"}
+    for r in rows:
+        assert keys <= set(r) and r["method"] == "hc" and r["steps"] > 0
+    assert "world/robot" in entity_paths_in(rrd)
+
+
+def test_evaluate_rejects_unknown_scenarios(capsys):
+    assert main(["evaluate", "--method", "scripted", "--scenario", "moonwalk"]) == 2
+    assert "unknown scenario 'moonwalk'" in capsys.readouterr().err

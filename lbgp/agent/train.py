@@ -219,13 +219,11 @@ class Trainer:
             interrupted = True
         finally:
             signal.signal(signal.SIGTERM, previous)
-            for msg in actors.stop():
-                pass  # transitions collected after the stop are not counted: the checkpoint is the state
+            actors.stop()  # transitions still in flight are dropped: the checkpoint below is the state
             if bar is not None:
                 bar.close()
         self.checkpoint()
-        summary = self._finish(interrupted)
-        return summary
+        return self._finish(interrupted)
 
     def _on_sigterm(self, signum, frame):
         raise Stop()

@@ -36,9 +36,10 @@ deeper into the person's safety radius (moving out of it, e.g. away from a perso
 towards the robot, is allowed).
 
 If the person's predicted path crosses the band within the next ``slowdown_horizon`` seconds at
-its time-optimal timing, the band is re-timed
-slower (``slowdown_factors`` of the speed limits) until it clears: the robot waits for the person
-to pass rather than racing them. The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
+its time-optimal timing, the band is re-timed slower (``slowdown_factors`` of the speed limits)
+until it clears: the robot waits for the person to pass rather than racing them.
+
+The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
 limits over one control period, so the hard limits hold even when the band is only approximately
 feasible. Failures (bad input, goal inside the person's safety radius, infeasible QP, solver error,
 diverging band) return a safe stop (decelerate within limits) with a status that says why.
@@ -201,17 +202,13 @@ class TebPlanner:
             self._forget_band()
             return self._stop(v_now, w_now, status, t_start, band, person_pose[:2], person_vel, done)
         band.dt = self._timing(band, v_now, w_now, goal_speed)
-        clearance = self._clearance(band, person_pose[:2], person_vel)
-        near = band.times <= cfg.slowdown_horizon
-        near[0] = False
-        if near.any() and clearance[near].min() < cfg.safety_distance - cfg.clearance_tolerance:
+        clear_soon, clearance = self._clear_soon(band, person_pose[:2], person_vel)
+        if not clear_soon:
             # the person would cross the band soon while we drive it: wait for them, drive it slower
             for slower in cfg.slowdown_factors:
                 timed = Band(band.poses, self._timing(band, v_now, w_now, goal_speed, speed_scale=slower))
-                c = self._clearance(timed, person_pose[:2], person_vel)
-                near = timed.times <= cfg.slowdown_horizon
-                near[0] = False
-                if not near.any() or c[near].min() >= cfg.safety_distance - cfg.clearance_tolerance:
+                clear_soon, c = self._clear_soon(timed, person_pose[:2], person_vel)
+                if clear_soon:
                     band.dt, clearance = timed.dt, c
                     break
         if clearance[1] < cfg.safety_distance - cfg.clearance_tolerance and clearance[1] < clearance[0]:
@@ -348,6 +345,15 @@ class TebPlanner:
         lo = self._lo
         lo[self.nvar :] = cfg.safety_distance - dist
         return P, q, A, lo, self._hi
+
+    def _clear_soon(self, band: Band, person_xy, person_vel) -> tuple[bool, np.ndarray]:
+        """Whether the poses within ``slowdown_horizon`` (after the first) keep the safety distance
+        from the predicted person; also returns every pose's clearance."""
+        cfg = self.cfg
+        clearance = self._clearance(band, person_xy, person_vel)
+        near = band.times <= cfg.slowdown_horizon
+        near[0] = False
+        return bool(not near.any() or clearance[near].min() >= cfg.safety_distance - cfg.clearance_tolerance), clearance
 
     def _clearance(self, band: Band, person_xy, person_vel) -> np.ndarray:
         """Distance of each band pose from the person's predicted position at that pose's time."""

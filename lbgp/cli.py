@@ -8,6 +8,8 @@ import os
 import sys
 from pathlib import Path
 
+from lbgp.policies import default_policy_path
+
 
 def _write_json_atomic(path: Path, data) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -26,13 +28,6 @@ def _print_table(rows: list[dict]) -> None:
             f"{r['setting']:<18}{r['steps']:>6d}{r['reward']:>9.2f}{r['distance_mean']:>8.2f}{r['distance_std']:>7.2f}"
             f"{r['alpha_mean_deg']:>11.1f}{r['alpha_std_deg']:>10.1f}  {end}"
         )
-
-
-PRETRAINED = Path(__file__).resolve().parent / "agent" / "pretrained"
-
-
-def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:
-    return PRETRAINED / f"{method}_{robot}.pt"
 
 
 def cmd_demo(args) -> int:
@@ -69,23 +64,9 @@ def cmd_demo(args) -> int:
 def cmd_evaluate(args) -> int:
     from lbgp.evaluate import evaluate, resolve_names
 
-    if args.method in ("lbgp", "e2e"):
-        from lbgp.agent import load_policy
+    from lbgp.policies import make_policy
 
-        path = Path(args.policy) if args.policy else default_policy_path(args.method)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such policy file")
-        policy = load_policy(path)
-        if policy.method != args.method:
-            raise ValueError(f"{path} holds a {policy.method} policy, not {args.method}")
-    elif args.method == "hc":
-        from lbgp.baselines.hc import HCPolicy
-
-        policy = HCPolicy(distance=args.hc_distance, horizon=args.hc_horizon)
-    else:
-        from lbgp.rollout import ConstantGoalPolicy
-
-        policy = ConstantGoalPolicy((1.5, 0.0))
+    policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon)
     names = resolve_names(args.scenario)
     recorder = None
     if args.record:
@@ -125,6 +106,49 @@ def cmd_train(args) -> int:
         summary = train(cfg, args.out, backend=args.backend)
     print(json.dumps(summary, indent=2))
     return 130 if summary.get("interrupted") else 0
+
+
+def cmd_deploy(args) -> int:
+    from lbgp.policies import make_policy
+    from lbgp.real.deploy import deploy
+
+    policy = make_policy(args.method, args.policy)
+    print(f"lbgp deploy: {args.method} policy, source {args.source}, sink {args.sink or 'default'}, robot {args.robot}"
+          + (f", logging to {args.log}" if args.log else ""))
+    loop = None
+    try:
+        loop = deploy(policy, source=args.source, sink=args.sink, robot=args.robot, steps=args.steps, log=args.log,
+                      record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
+                      metadata={"method": args.method, "policy": args.policy or "default"})
+    except KeyboardInterrupt:
+        print("interrupted: a zero command was sent")
+        return 130
+    summary = {"end": loop.end_reason, "ticks": loop.ticks, "agent_steps": loop.agent_steps, **loop.metrics.summary(),
+               "rejected_frames": loop.monitor.counts}
+    print(json.dumps(summary, indent=2))
+    if args.json:
+        _write_json_atomic(Path(args.json), summary)
+    return 0
+
+
+def cmd_replay(args) -> int:
+    from lbgp.real.replay import replay_log
+
+    recorder = None
+    if args.record:
+        from lbgp.viz.recording import EpisodeRecorder
+
+        recorder = EpisodeRecorder(args.record)
+    try:
+        metrics, log = replay_log(args.log, recorder)
+    finally:
+        if recorder is not None:
+            recorder.close()
+    summary = {"log": args.log, "truncated": log["truncated"], "metadata": log["metadata"], **metrics.summary()}
+    print(json.dumps(summary, indent=2))
+    if args.json:
+        _write_json_atomic(Path(args.json), summary)
+    return 0
 
 
 def cmd_plot_curves(args) -> int:
@@ -169,10 +193,32 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--minutes", type=float, default=None, help="also stop after this much wall time")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--actors", type=int, default=4, help="actor processes (one of them exploits)")
-    p.add_argument("--backend", default="processes", choices=["processes", "ray"])
+    p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],
+                   help="processes: actor processes (default); inline: one process, reproducible; ray: Ray tasks (extra)")
     p.add_argument("--out", help="run directory (created)")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its last checkpoint")
     p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser("deploy", help="run a policy on a robot (or the simulated one): poses in, commands out")
+    p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])
+    p.add_argument("--policy", help="policy file (default: the shipped pretrained Jackal policy of the method)")
+    p.add_argument("--source", default="sim", help="vicon://HOST, optitrack://HOST, udp://[HOST:]PORT[?from=IP], mcap://FILE or sim[://SCENARIO]")
+    p.add_argument("--sink", help="udp://HOST:PORT, ros2[:///TOPIC], sim or none (default: sim for a sim source, else none)")
+    p.add_argument("--robot", default="turtlebot2", choices=["jackal", "turtlebot2"])
+    p.add_argument("--steps", type=int, help="agent steps (0.2 s) to run; default: until Ctrl-C or the source ends")
+    p.add_argument("--seed", type=int, default=0, help="sim source: seed")
+    p.add_argument("--person-path", help="sim source: CSV of x,y waypoints for the person")
+    p.add_argument("--log", help="write an MCAP log (ROS 2 schemas, opens in Foxglove)")
+    p.add_argument("--record", help="write a rerun recording (.rrd)")
+    p.add_argument("--spawn", action="store_true", help="open a live rerun viewer")
+    p.add_argument("--json", help="write the run's summary here")
+    p.set_defaults(func=cmd_deploy)
+
+    p = sub.add_parser("replay", help="re-play an lbgp MCAP log: metrics and a rerun recording")
+    p.add_argument("log", help="the .mcap file written by lbgp deploy --log")
+    p.add_argument("--record", help="write a rerun recording (.rrd)")
+    p.add_argument("--json", help="write the metrics here")
+    p.set_defaults(func=cmd_replay)
 
     p = sub.add_parser("plot-curves", help="learning curves of runs (mean and half-std band over seeds)")
     p.add_argument("run_dirs", nargs="+", help="run directories; runs with the same label are averaged")
@@ -187,7 +233,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (ValueError, FileNotFoundError) as exc:
+    except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"lbgp {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

@@ -1,0 +1,42 @@
+"""One place that turns a method name (+ optional policy file) into a policy object.
+
+Every policy has ``control`` ("goal" or "velocity"), ``act(observation) -> action`` and optionally
+``reset()``; the simulator, the experiments and the real robot all get theirs from ``make_policy``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+METHODS = ("lbgp", "e2e", "hc", "scripted")
+PRETRAINED = Path(__file__).resolve().parent / "agent" / "pretrained"
+HC_DEFAULTS = {"distance": 1.5, "horizon": 1.0}
+
+
+def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:
+    return PRETRAINED / f"{method}_{robot}.pt"
+
+
+def make_policy(method: str, policy_file=None, hc_distance: float | None = None, hc_horizon: float | None = None):
+    """The policy of ``method``: lbgp/e2e load ``policy_file`` (default: the shipped Jackal one),
+    hc builds the EKF baseline, scripted asks for a goal 1.5 m ahead."""
+    if method in ("lbgp", "e2e"):
+        from lbgp.agent import load_policy
+
+        path = Path(policy_file) if policy_file else default_policy_path(method)
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such policy file")
+        policy = load_policy(path)
+        if policy.method != method:
+            raise ValueError(f"{path} holds a {policy.method} policy, not {method}")
+        return policy
+    if method == "hc":
+        from lbgp.baselines.hc import HCPolicy
+
+        return HCPolicy(distance=HC_DEFAULTS["distance"] if hc_distance is None else hc_distance,
+                        horizon=HC_DEFAULTS["horizon"] if hc_horizon is None else hc_horizon)
+    if method == "scripted":
+        from lbgp.rollout import ConstantGoalPolicy
+
+        return ConstantGoalPolicy((1.5, 0.0))
+    raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")

@@ -1,0 +1,38 @@
+"""``deploy``: wire a pose source, a policy and a command sink into a DeployLoop and run it."""
+
+from __future__ import annotations
+
+from lbgp.real.endpoints import open_sink, open_source
+from lbgp.real.loop import DeployConfig, DeployLoop
+
+
+def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
+           log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
+           end_distance: float | None = None, metadata: dict | None = None):
+    """Run the loop until ``steps`` agent steps (or the source ends, or Ctrl-C); returns the loop
+    (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``)."""
+    pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance)
+    command_sink = open_sink(sink or ("sim" if world is not None else "none"), world=world)
+    logger = recorder = None
+    try:
+        if log:
+            from lbgp.real.mcap_log import McapLogger
+
+            logger = McapLogger(log, metadata={"robot": robot, "source": source, **(metadata or {})})
+        if record or spawn_viewer:
+            from lbgp.viz.recording import EpisodeRecorder
+
+            recorder = EpisodeRecorder(record, spawn=spawn_viewer)
+        end_condition = (lambda: "contact" if world.contact else None) if world is not None else None
+        loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance),
+                          logger=logger, recorder=recorder, end_condition=end_condition)
+        loop.world = world
+        loop.run()
+        return loop
+    finally:
+        if logger is not None:
+            logger.close()
+        if recorder is not None:
+            recorder.close()
+        command_sink.close()
+        pose_source.close()

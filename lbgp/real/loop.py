@@ -1,0 +1,237 @@
+"""The deployment loop: poses in, the same observation, policy and planner as in simulation,
+commands out.
+
+    pose source --frames--> SafetyMonitor --WorldState--> ObservationStack -> policy (5 Hz)
+                                                      \\-> controller (planner, 10 Hz) --> command sink
+
+Everything between the source and the sink is the simulator's own code: ``lbgp.world.WorldState``,
+``lbgp.sim.observation.ObservationStack``, ``lbgp.control`` (GoalController with the TEB planner,
+or VelocityController for E2E) and ``lbgp.metrics``. Only where poses come from and where
+commands go differ.
+
+Each tick (every ``planner_period``): read the frames that arrived, check them (see
+lbgp.real.safety), and then either compute a command from good data or, on any stop reason,
+ramp the command to zero within ``SafetyConfig.stop_time``. Every second tick is an agent step
+(policy + observation frame + metrics). The robot's velocity for the planner is the last command
+sent (a robot without odometry feedback follows its commands); the person's velocity is a finite
+difference of its poses over one agent period, exactly as in simulation. Whatever ends the loop
+(its step budget, the source ending, Ctrl-C, an exception) a zero command is sent last.
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from lbgp.control import GoalController, VelocityController
+from lbgp.geometry import distance_and_alpha
+from lbgp.metrics import EpisodeMetrics
+from lbgp.planner import TebPlanner, clamp_command, planner_config_for
+from lbgp.real import safety as safety_lib
+from lbgp.real.safety import SafetyConfig, SafetyMonitor
+from lbgp.sim import observation as obs_lib
+from lbgp.sim.rewards import follow_ahead_reward
+from lbgp.sim.robots import get_robot
+from lbgp.world import WorldState
+
+SHUTDOWN = "shutdown"
+
+
+class WallClock:
+    def __init__(self):
+        self._t0 = time.monotonic()
+
+    def now(self) -> float:
+        return time.monotonic() - self._t0
+
+    def sleep_until(self, t: float) -> None:
+        delay = t - self.now()
+        if delay > 0:
+            time.sleep(delay)
+
+
+@dataclasses.dataclass
+class DeployConfig:
+    robot: str = "turtlebot2"
+    planner_period: float = 0.1  # s between commands
+    max_steps: int | None = None  # agent steps (0.2 s) before the loop ends; None: until stopped
+    max_duration: float | None = None  # s of loop clock before the loop ends (counts stopped time too)
+    end_distance: float | None = None  # end the run when D exceeds this (the real-world protocol: 3 m)
+    safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
+
+
+@dataclasses.dataclass
+class TickRecord:
+    """What one tick saw and did (kept in memory for tests and summaries, and logged)."""
+
+    t: float
+    status: str
+    v: float
+    w: float
+    agent_step: bool = False
+    robot: np.ndarray | None = None
+    person: np.ndarray | None = None
+    observation: np.ndarray | None = None
+    goal: np.ndarray | None = None
+    band: np.ndarray | None = None
+    planner_status: str = ""
+    latency_s: float = math.nan  # from reading the newest frame to sending the command
+    reward: float = math.nan  # agent steps only
+    distance_alpha: tuple = (math.nan, math.nan)
+
+
+class DeployLoop:
+    def __init__(self, source, sink, policy, config: DeployConfig | None = None, clock=None, logger=None,
+                 recorder=None, end_condition=None, keep_records: bool = True):
+        self.cfg = config or DeployConfig()
+        self.source, self.sink, self.policy = source, sink, policy
+        self.clock = clock or getattr(source, "clock", None) or WallClock()
+        self.logger, self.recorder = logger, recorder
+        self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
+        self.limits = planner_config_for(get_robot(self.cfg.robot))
+        if policy.control == "goal":
+            self.controller = GoalController(TebPlanner(self.limits))
+        else:
+            self.controller = VelocityController(self.limits)
+        self.monitor = SafetyMonitor(self.cfg.safety)
+        self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance
+        self.stack = obs_lib.ObservationStack()
+        self.metrics = EpisodeMetrics(setting="deploy")
+        self.records: list[TickRecord] | None = [] if keep_records else None
+        self.command = (0.0, 0.0)
+        self.ticks = 0
+        self.agent_steps = 0
+        self.end_reason = ""
+        self._people: collections.deque = collections.deque(maxlen=64)  # (t, person pose) accepted
+        self._started = False
+        self._last_agent_t = -math.inf
+        self._last_good = -math.inf
+
+    # ------------------------------------------------------------------ one tick
+    def _person_velocity(self, frame) -> np.ndarray:
+        """Finite difference over about one agent period of source time, as in simulation."""
+        target = frame.t - obs_lib.FRAME_PERIOD
+        older = [(t, p) for t, p in self._people if t <= target + 1e-6]
+        t0, p0 = older[-1] if older else self._people[0]
+        return obs_lib.estimate_person_velocity(p0, frame.person, frame.t - t0)
+
+    def _stop_command(self) -> tuple[float, float]:
+        """Towards zero at the emergency deceleration (limit -> 0 in ``stop_time``)."""
+        dt, stop = self.cfg.planner_period, self.cfg.safety.stop_time
+        dv = max(self.limits.max_vel_x, self.limits.max_vel_x_backwards) * dt / stop
+        dw = self.limits.max_vel_theta * dt / stop
+        v, w = self.command
+        return (math.copysign(max(abs(v) - dv, 0.0), v), math.copysign(max(abs(w) - dw, 0.0), w))
+
+    def tick(self) -> TickRecord:
+        now = self.clock.now()
+        frames = self.source.poll(now)
+        t_read = time.perf_counter()
+        status = self.monitor.update(frames, now)
+        frame = self.monitor.last
+        record = TickRecord(now, status, 0.0, 0.0)
+        if status == safety_lib.OK:
+            if not self._people or self._people[-1][0] < frame.t:
+                self._people.append((frame.t, frame.person.copy()))
+            record.robot, record.person = frame.robot.copy(), frame.person.copy()
+            distance, alpha = distance_and_alpha(frame.robot, frame.person)
+            if distance < self.min_distance:
+                status = record.status = safety_lib.TOO_CLOSE
+        if status == safety_lib.OK:
+            state = WorldState(frame.t, frame.robot.copy(), np.array(self.command), frame.person.copy(), self._person_velocity(frame))
+            if now - self._last_good > self.cfg.safety.reanchor_after:  # first data, or back after a long gap
+                self.stack.reset(state.robot_pose, state.person_pose)
+                self.controller.reset()
+                if hasattr(self.policy, "reset"):
+                    self.policy.reset()
+                self._last_agent_t = -math.inf
+            self._last_good = now
+            if now - self._last_agent_t >= obs_lib.FRAME_PERIOD - 1e-6:
+                self._agent_step(state, record, distance, alpha)
+                self._last_agent_t = now
+            cmd = self.controller.command(state)
+            v, w = clamp_command(cmd.v, cmd.w, self.command[0], self.command[1], self.limits)
+            record.planner_status = cmd.status
+            record.goal = None if cmd.goal is None else cmd.goal.copy()
+            record.band = None if cmd.plan is None else cmd.plan.poses.copy()
+        else:
+            v, w = self._stop_command()
+        self.command = (v, w)
+        self.sink.send(now, v, w, status)
+        record.v, record.w = v, w
+        if frames:
+            record.latency_s = time.perf_counter() - t_read
+        self.ticks += 1
+        if self.logger is not None:
+            self.logger.log_tick(record)
+        if self.recorder is not None and record.agent_step:
+            distance, alpha = record.distance_alpha
+            self.recorder.log_step({"time": record.t, "distance": distance, "alpha": alpha, "robot_pose": record.robot,
+                                    "person_pose": record.person, "goal": record.goal, "band": record.band}, record.reward)
+        if self.records is not None:
+            self.records.append(record)
+        return record
+
+    def _agent_step(self, state: WorldState, record: TickRecord, distance: float, alpha: float) -> None:
+        self.stack.push(state.robot_pose, state.person_pose)
+        observation = self.stack.vector()
+        self.controller.set_action(self.policy.act(observation), state)
+        reward = follow_ahead_reward(distance, alpha)
+        self.metrics.add(distance, alpha, reward)
+        self.agent_steps += 1
+        record.agent_step = True
+        record.observation = observation
+        record.reward = reward
+        record.distance_alpha = (distance, alpha)
+
+    # ------------------------------------------------------------------ the loop
+    def _finished(self, record: TickRecord) -> str:
+        cfg = self.cfg
+        if cfg.max_steps is not None and self.agent_steps >= cfg.max_steps:
+            return "steps"
+        if cfg.max_duration is not None and record.t - self._start_t >= cfg.max_duration - 1e-9:
+            return "duration"
+        if getattr(self.source, "finished", False):
+            return "source_ended"
+        if cfg.end_distance is not None and record.robot is not None:
+            if distance_and_alpha(record.robot, record.person)[0] > cfg.end_distance:
+                return "too_far"
+        if self.end_condition is not None:
+            return self.end_condition() or ""
+        return ""
+
+    def run(self) -> EpisodeMetrics:
+        """Tick until the budget, the source or an end condition ends the run; always sends zero last."""
+        period = self.cfg.planner_period
+        next_tick = self._start_t = self.clock.now()
+        if self.recorder is not None:
+            self.recorder.begin_episode("deploy")
+        try:
+            while True:
+                self.clock.sleep_until(next_tick)
+                record = self.tick()
+                self.end_reason = self._finished(record)
+                if self.end_reason:
+                    break
+                next_tick += period
+                if self.clock.now() > next_tick + period:  # fell behind (slow machine): do not burst
+                    next_tick = self.clock.now()
+        except KeyboardInterrupt:
+            self.end_reason = "interrupted"
+            raise
+        except BaseException:
+            self.end_reason = "error"
+            raise
+        finally:
+            self.command = (0.0, 0.0)
+            self.sink.send(self.clock.now(), 0.0, 0.0, SHUTDOWN)
+            if self.logger is not None:
+                self.logger.log_tick(TickRecord(self.clock.now(), SHUTDOWN, 0.0, 0.0))
+                self.logger.close()
+        self.metrics.contact = self.end_reason == "contact"
+        self.metrics.terminated_early = self.end_reason not in ("steps", "duration", "source_ended", "")
+        return self.metrics

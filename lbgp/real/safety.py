@@ -1,0 +1,85 @@
+"""The deployment loop's safety rules: which pose frames may be used, and when the robot must stop.
+
+A frame is *rejected* (never used for a command) when it has a NaN/inf, when its timestamp is not
+newer than the last accepted frame's (out of order or repeated), or when the robot or the person
+moved more than ``max_jump`` metres since the last accepted frame (no person or robot can; a
+mocap swap or glitch can). The data is *stale* when no frame was accepted for ``stale_after``
+seconds, and the loop also stops the robot at once when the newest frame of a tick was rejected;
+it drives again as soon as good frames return. After
+``reanchor_after`` seconds without an accepted frame the jump check starts afresh from the next
+finite, in-order frame (the bodies may really have moved far during a long dropout).
+
+Independent of the data, the robot stops whenever it is closer than ``min_distance`` to the
+person, whatever the policy wants.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from lbgp.real.frames import PoseFrame
+
+OK = "ok"
+STALE = "stale"
+NON_FINITE = "non_finite"
+OUT_OF_ORDER = "out_of_order"
+JUMP = "jump"
+TOO_CLOSE = "too_close"
+NO_DATA = "no_data"
+STOP_REASONS = (NO_DATA, STALE, NON_FINITE, OUT_OF_ORDER, JUMP, TOO_CLOSE)
+
+
+@dataclasses.dataclass
+class SafetyConfig:
+    stale_after: float = 0.25  # s without an accepted frame -> stop
+    max_jump: float = 1.5  # m between consecutive accepted frames, per body
+    reanchor_after: float = 1.0  # s without an accepted frame -> next good frame is the new anchor
+    min_distance: float | None = None  # m robot-person centre distance; None: the planner's safety distance
+    stop_time: float = 0.15  # s: a safety stop brings the commanded speed from its limit to 0 this fast
+
+
+class SafetyMonitor:
+    def __init__(self, config: SafetyConfig | None = None):
+        self.cfg = config or SafetyConfig()
+        self.last: PoseFrame | None = None  # last accepted frame
+        self.last_rejection = ""
+        self.counts = {reason: 0 for reason in (NON_FINITE, OUT_OF_ORDER, JUMP)}
+
+    def check(self, frame: PoseFrame) -> str:
+        """OK if the frame may be used (and remember it), else the reason it may not."""
+        if not frame.is_finite():
+            return self._reject(NON_FINITE)
+        last = self.last
+        if last is not None:
+            if frame.t <= last.t:
+                return self._reject(OUT_OF_ORDER)
+            if frame.received - last.received <= self.cfg.reanchor_after and (
+                np.hypot(*(frame.robot[:2] - last.robot[:2])) > self.cfg.max_jump
+                or np.hypot(*(frame.person[:2] - last.person[:2])) > self.cfg.max_jump
+            ):
+                return self._reject(JUMP)
+        self.last = frame
+        return OK
+
+    def _reject(self, reason: str) -> str:
+        self.counts[reason] += 1
+        self.last_rejection = reason
+        return reason
+
+    def update(self, frames: list[PoseFrame], now: float) -> str:
+        """Check the frames that arrived since the last tick; the data status for this tick:
+        the newest frame's rejection reason if it was bad, NO_DATA before the first good frame,
+        STALE when the last good frame is older than ``stale_after``, else OK."""
+        newest = OK
+        for frame in frames:
+            newest = self.check(frame)
+        if newest != OK:
+            return newest
+        if self.last is None:
+            return NO_DATA
+        if not now - self.last.received <= self.cfg.stale_after:
+            return STALE
+        return OK

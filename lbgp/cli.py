@@ -69,10 +69,10 @@ def cmd_evaluate(args) -> int:
     policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon)
     names = resolve_names(args.scenario)
     recorder = None
-    if args.record:
+    if args.record or args.spawn:
         from lbgp.viz.recording import EpisodeRecorder
 
-        recorder = EpisodeRecorder(args.record)
+        recorder = EpisodeRecorder(args.record, spawn=args.spawn)
     try:
         results = evaluate(policy, args.method, names, robot=args.robot, episodes=args.episodes, seed=args.seed,
                            recorder=recorder, person_path=args.person_path)
@@ -151,6 +151,37 @@ def cmd_replay(args) -> int:
     return 0
 
 
+def cmd_experiment(args) -> int:
+    command = "lbgp experiment " + " ".join(sys.argv[2:]) if sys.argv[1:2] == ["experiment"] else f"lbgp experiment {args.which}"
+    policies = {"lbgp": args.lbgp_policy, "e2e": args.e2e_policy}
+    if args.which == "sim":
+        from lbgp.experiments.sim_table import run_sim_table
+
+        run_sim_table(args.out, episodes=args.episodes, seed=args.seed, scenarios=args.scenarios, policies=policies,
+                      horizon=args.horizon, command=command)
+        print(Path(args.out, "sim_table.md").read_text())
+    elif args.which == "real-protocol":
+        from lbgp.experiments.real_protocol import run_real_protocol
+
+        if args.robot != "turtlebot2":
+            raise ValueError("the real-world protocol uses the TurtleBot 2 (the paper's robot): --robot turtlebot2")
+        run_real_protocol(args.out, steps=args.steps, seed=args.seed, paths=args.paths, policies=policies, repeats=args.repeats,
+                          command=command)
+        print(Path(args.out, "real_protocol_table.md").read_text())
+    else:
+        from lbgp.experiments.ablation import run_ablation
+
+        report = run_ablation(args.out, minutes=args.minutes, seeds=args.seeds, steps=args.max_steps, backend=args.backend,
+                              runs_dir=args.runs_dir, command=command)
+        print(json.dumps({k: v.get("final_exploit_return_mean_last20") for k, v in report["runs"].items()}, indent=2))
+        print(f"wrote {Path(args.out, 'ablation_curves.png')}")
+    return 0
+
+
+def _names(text: str) -> list[str]:
+    return [n.strip() for n in text.split(",") if n.strip()]
+
+
 def cmd_plot_curves(args) -> int:
     from lbgp.viz.curves import plot_learning_curves
 
@@ -174,8 +205,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("evaluate", help="seeded episodes of a method on levels or scenarios; metrics table and JSON")
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])
     p.add_argument("--policy", help="policy file (default: the shipped pretrained one for the method)")
-    p.add_argument("--hc-distance", type=float, default=1.5, help="HC: goal distance ahead of the predicted person (m)")
-    p.add_argument("--hc-horizon", type=float, default=1.0, help="HC: prediction horizon (s)")
+    p.add_argument("--hc-distance", type=float, default=None, help="HC: goal distance ahead of the predicted person (m, default 1.5)")
+    p.add_argument("--hc-horizon", type=float, default=None, help="HC: EKF prediction horizon (s, default 0: the planner predicts the goal)")
     p.add_argument("--scenario", default="all", help="all (paper scenarios), levels, or comma-separated names")
     p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
     p.add_argument("--episodes", type=int, default=10)
@@ -183,6 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--person-path", help="CSV of x,y waypoints for the person (replaces the scenario's motion)")
     p.add_argument("--json", help="write the metrics here")
     p.add_argument("--record", help="write a rerun recording (.rrd) of every episode")
+    p.add_argument("--spawn", action="store_true", help="also open a live rerun viewer (when one is installed)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -198,6 +230,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="run directory (created)")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its last checkpoint")
     p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser("experiment", help="the paper's experiments: sim table, real-world protocol in sim, ablation")
+    exp = p.add_subparsers(dest="which", metavar="EXPERIMENT", required=True)
+    for name, help_text in (("sim", "9 scenarios x LBGP/HC/E2E on the Jackal -> results/sim_table.md + .csv"),
+                            ("real-protocol", "Straight/S-shape/U-turn x 4 settings on the TurtleBot 2 through the deploy loop with "
+                                              "simulated mocap -> results/real_protocol_table.md + .csv"),
+                            ("ablation", "train LBGP, LBGP-no-curriculum and E2E over seeds -> results/ablation_curves.png")):
+        q = exp.add_parser(name, help=help_text)
+        q.add_argument("--out", default="results", help="output folder (default: results)")
+        q.add_argument("--seed", type=int, default=0)
+        q.add_argument("--lbgp-policy", help="LBGP policy file (default: the shipped one)")
+        q.add_argument("--e2e-policy", help="E2E policy file (default: the shipped one)")
+        if name == "sim":
+            q.add_argument("--episodes", type=int, default=5, help="seeded episodes per scenario and method")
+            q.add_argument("--horizon", type=int, default=35, help="agent steps per episode")
+            q.add_argument("--scenarios", type=_names, help="comma-separated subset of the 9 scenarios")
+        if name == "real-protocol":
+            q.add_argument("--robot", default="turtlebot2", choices=["turtlebot2", "jackal"])
+            q.add_argument("--steps", type=int, default=60, help="agent steps per setting (constant, as in the paper)")
+            q.add_argument("--repeats", type=int, default=1, help="runs per setting (different mocap noise)")
+            q.add_argument("--paths", type=_names, help="comma-separated subset of straight,s_shape,u_turn")
+        if name == "ablation":
+            q.add_argument("--minutes", type=float, default=10.0, help="wall-time budget per training run")
+            q.add_argument("--seeds", type=lambda t: [int(x) for x in _names(t)], default=[0, 1], help="comma-separated seeds")
+            q.add_argument("--max-steps", type=int, help="also stop each run after this many env steps")
+            q.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"])
+            q.add_argument("--runs-dir", help="where the training runs go (default: OUT/ablation_runs)")
+        q.set_defaults(func=cmd_experiment)
 
     p = sub.add_parser("deploy", help="run a policy on a robot (or the simulated one): poses in, commands out")
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])

@@ -70,6 +70,6 @@ def test_hc_goal_is_ahead_of_the_predicted_person():
     stack.reset(np.array([2.0, 0.0, 0.0]), turning[0])
     for p in turning[1:]:
         stack.push(np.array([0.0, 0.0, 0.0]), p)
-    goal = HCPolicy().goal(stack.vector())
+    goal = HCPolicy(horizon=1.0).goal(stack.vector())
     assert goal[1] > 0.5  # a left turn puts the goal to the person's left
     assert math.isfinite(goal[0])

@@ -68,13 +68,58 @@ class ActorSpec:
     seed: int
 
 
+def choose_level(spec: ActorSpec, cfg: D4PGConfig, current: int, rng: np.random.Generator) -> str:
+    """The curriculum level of the next episode: the current one, or for exploring actors now and
+    then an earlier one (``earlier_level_share``) so that nothing learnt is forgotten."""
+    if spec.exploring and current > 0 and cfg.curriculum and rng.uniform() < cfg.earlier_level_share:
+        return CURRICULUM[int(rng.integers(0, current))]
+    return CURRICULUM[current]
+
+
+def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.random.Generator, nstep: NStepAccumulator, refresh=None):
+    """One episode; returns (n-step transition batch, return, steps). ``refresh()`` is called every
+    ``weight_sync_steps`` steps so that long episodes pick up new weights."""
+    transitions, episode_return, steps = [], 0.0, 0
+    nstep.reset()
+    timestep = env.reset()
+    while not timestep.last():
+        obs = timestep.observation
+        with torch.no_grad():
+            action = actor(torch.from_numpy(obs)[None])[0].numpy()
+        if exploring:
+            action = np.clip(action + cfg.sigma * rng.normal(size=ACTION_SIZE), -1.0, 1.0).astype(np.float32)
+        timestep = env.step(action)
+        episode_return += timestep.reward
+        steps += 1
+        terminal = timestep.last() and timestep.discount == 0.0
+        truncated = timestep.last() and not terminal
+        transitions += nstep.step(obs, action, timestep.reward, timestep.observation, terminal, truncated)
+        if refresh is not None and steps % cfg.weight_sync_steps == 0:
+            refresh()
+    batch = tuple(np.array([t[i] for t in transitions], np.float32) for i in range(5))
+    return batch, float(episode_return), steps
+
+
+class EnvCache:
+    """One environment per curriculum level, created on first use with a seed from ``rng``."""
+
+    def __init__(self, cfg: D4PGConfig, rng: np.random.Generator):
+        self.cfg, self.rng, self.envs = cfg, rng, {}
+
+    def __call__(self, level: str):
+        if level not in self.envs:
+            from lbgp.sim import make_env
+
+            cfg = self.cfg
+            self.envs[level] = make_env(level, robot=cfg.robot, seed=int(self.rng.integers(2**31)), control=cfg.control, horizon=cfg.horizon)
+        return self.envs[level]
+
+
 def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, queue, stop) -> None:
     """The actor loop (runs in its own process until ``stop`` is set)."""
     torch.set_num_threads(1)
     if cfg_dict.get("actor_niceness"):
         os.nice(int(cfg_dict["actor_niceness"]))  # the learner gets the CPU it needs first
-    from lbgp.sim import make_env
-
     cfg = D4PGConfig.from_dict(cfg_dict)
     if hasattr(queue, "cancel_join_thread"):
         queue.cancel_join_thread()  # never hang at exit on a queue nobody reads any more
@@ -82,45 +127,23 @@ def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, 
     rng = np.random.default_rng(spec.seed)
     actor = Actor(obs_lib.SIZE, ACTION_SIZE, cfg.hidden)
     version = -1
-    envs: dict = {}
+    envs = EnvCache(cfg, rng)
     nstep = NStepAccumulator(cfg.n_step, cfg.discount)
+
+    def refresh():
+        nonlocal version
+        version, flat = board.fetch(version)
+        if flat is not None:
+            load_flat_parameters(actor, flat)
+
     try:
         while not stop.is_set():
             if parent is not None and not parent.is_alive():
                 return  # the learner died (e.g. killed): do not linger as an orphan
-            version, flat = board.fetch(version)
-            if flat is not None:
-                load_flat_parameters(actor, flat)
-            current = int(level_index.value)
-            level = CURRICULUM[current]
-            if spec.exploring and current > 0 and cfg.curriculum and rng.uniform() < cfg.earlier_level_share:
-                level = CURRICULUM[int(rng.integers(0, current))]
-            if level not in envs:
-                envs[level] = make_env(level, robot=cfg.robot, seed=int(rng.integers(2**31)), control=cfg.control, horizon=cfg.horizon)
-            env = envs[level]
-            transitions, episode_return, steps, since_sync = [], 0.0, 0, 0
-            nstep.reset()
-            timestep = env.reset()
-            while not timestep.last():
-                obs = timestep.observation
-                with torch.no_grad():
-                    action = actor(torch.from_numpy(obs)[None])[0].numpy()
-                if spec.exploring:
-                    action = np.clip(action + cfg.sigma * rng.normal(size=ACTION_SIZE), -1.0, 1.0).astype(np.float32)
-                timestep = env.step(action)
-                episode_return += timestep.reward
-                steps += 1
-                since_sync += 1
-                terminal = timestep.last() and timestep.discount == 0.0
-                truncated = timestep.last() and not terminal
-                transitions += nstep.step(obs, action, timestep.reward, timestep.observation, terminal, truncated)
-                if since_sync >= cfg.weight_sync_steps:
-                    version, flat = board.fetch(version)
-                    if flat is not None:
-                        load_flat_parameters(actor, flat)
-                    since_sync = 0
-            batch = tuple(np.array([t[i] for t in transitions], np.float32) for i in range(5))
-            queue.put(("episode", spec.actor_id, spec.exploring, level, float(episode_return), steps, batch))
+            refresh()
+            level = choose_level(spec, cfg, int(level_index.value), rng)
+            batch, ret, steps = play_episode(envs(level), actor, spec.exploring, cfg, rng, nstep, refresh)
+            queue.put(("episode", spec.actor_id, spec.exploring, level, ret, steps, batch))
     except KeyboardInterrupt:  # the learner handles Ctrl-C; actors just stop
         pass
     finally:
@@ -204,3 +227,45 @@ def drain_until_exited(poll, count: int, timeout: float) -> list:
             else:
                 leftover.append(msg)
     return leftover
+
+
+class InlineActors:
+    """All actors in the learner's own process, one episode per ``poll`` in turn (backend
+    ``inline``). Slower on a multi-core machine but fully reproducible for a seed: the learner runs
+    ``max_updates_per_step`` updates per collected step between episodes. For tests and debugging."""
+
+    synchronous = True
+
+    def __init__(self, cfg: D4PGConfig, actor: Actor, restart: int = 0):
+        self.cfg = cfg
+        self.actor = actor  # the learner's own network: always the latest weights
+        self.specs = actor_specs(cfg, restart)
+        self.rngs = [np.random.default_rng(spec.seed) for spec in self.specs]
+        self.envs = [EnvCache(cfg, rng) for rng in self.rngs]
+        self.nstep = NStepAccumulator(cfg.n_step, cfg.discount)
+        self.level = 0
+        self.turn = 0
+        self.board = self  # publishing is a no-op: the actors use the learner's network
+
+    def publish(self, flat) -> None:
+        pass
+
+    def start(self) -> None:
+        pass
+
+    def set_level(self, index: int) -> None:
+        self.level = index
+
+    def poll(self, timeout: float = 0.0) -> list:
+        i = self.turn % len(self.specs)
+        self.turn += 1
+        spec, rng = self.specs[i], self.rngs[i]
+        level = choose_level(spec, self.cfg, self.level, rng)
+        batch, ret, steps = play_episode(self.envs[i](level), self.actor, spec.exploring, self.cfg, rng, self.nstep)
+        return [("episode", spec.actor_id, spec.exploring, level, ret, steps, batch)]
+
+    def alive(self) -> bool:
+        return True
+
+    def stop(self, timeout: float = 0.0) -> list:
+        return []

@@ -38,6 +38,7 @@ class D4PGConfig:
     actor_lr: float = 3e-4  # acme 1e-4; 3e-4 learns faster within the ~100k updates a 2-core budget allows
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
+    target_tau: float = 0.0  # > 0: soft (Polyak) target update by this much every step instead of hard updates
     num_atoms: int = 51  # (acme)
     v_min: float = -30.0  # acme [-150, 150] is for rewards ~1/step over 1000 steps; here rewards are in
     v_max: float = 30.0  # [-1, 1] and 1 / (1 - 0.97) = 33: +-30 covers every discounted return

@@ -46,7 +46,11 @@ class D4PGLearner:
         self.actor_opt.step()
 
         self.updates += 1
-        if self.updates % self.cfg.target_update_period == 0:
+        if self.cfg.target_tau > 0:
+            with torch.no_grad():
+                for net, target in ((self.actor, self.target_actor), (self.critic, self.target_critic)):
+                    torch._foreach_lerp_(list(target.parameters()), list(net.parameters()), self.cfg.target_tau)
+        elif self.updates % self.cfg.target_update_period == 0:
             self.target_actor.load_state_dict(self.actor.state_dict())
             self.target_critic.load_state_dict(self.critic.state_dict())
         return {"critic_loss": float(critic_loss.detach()), "actor_loss": float(actor_loss.detach()), "q": float(q.detach().mean())}

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from lbgp.agent.actors import ProcessActors, flat_parameters
+from lbgp.agent.actors import InlineActors, ProcessActors, flat_parameters
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.curriculum import Curriculum
@@ -147,8 +147,10 @@ class Trainer:
             from lbgp.agent.ray_backend import RayActors
 
             return RayActors(self.cfg, flat_size, self.restarts)
+        if self.backend == "inline":
+            return InlineActors(self.cfg, self.learner.actor, self.restarts)
         if self.backend != "processes":
-            raise ValueError(f"unknown backend {self.backend!r}; use 'processes' or 'ray'")
+            raise ValueError(f"unknown backend {self.backend!r}; use 'processes', 'inline' or 'ray'")
         return ProcessActors(self.cfg, flat_size, self.restarts)
 
     def _handle(self, msg, curve_writer) -> None:
@@ -197,7 +199,10 @@ class Trainer:
                         actors.set_level(self.curriculum.index)
                         published_level = self.curriculum.index
                     if can_learn:
-                        for _ in range(10):
+                        # asynchronous actors: a few updates between polls; inline actors: catch up
+                        # with the collected steps, so that a seeded run is reproducible
+                        due = int(cfg.max_updates_per_step * self.env_steps) - self.learner.updates
+                        for _ in range(max(due, 0) if getattr(actors, "synchronous", False) else 10):
                             self.learner.update(self.replay.sample(cfg.batch_size, self.rng))
                         if self.learner.updates % 50 == 0:
                             actors.board.publish(flat_parameters(self.learner.actor))

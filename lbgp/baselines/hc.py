@@ -2,7 +2,9 @@
 
 An EKF (CTRV, see ``ekf.py``) estimates the person's motion from the person's past poses, the goal
 is a point ``distance`` ahead of the person's position predicted ``horizon`` seconds ahead, along
-the predicted heading, and the same TEB planner drives there.
+the predicted heading, and the same TEB planner drives there. The default horizon is 0 s (the
+filtered current pose and heading): our planner already moves the goal with the person's velocity,
+so a forecast on top double-counts; ``horizon`` is kept for experiments.
 
 HC uses exactly what the learned policy sees: the observation (the person's last 10 poses at 5 Hz
 in the current person frame, noisy where the observation is noisy). Each call filters that window
@@ -24,7 +26,7 @@ class HCPolicy:
     control = "goal"
     method = "hc"
 
-    def __init__(self, distance: float = 1.5, horizon: float = 1.0, turn_rate: bool = True):
+    def __init__(self, distance: float = 1.5, horizon: float = 0.0, turn_rate: bool = True):
         self.distance = distance  # m ahead of the predicted person
         self.horizon = horizon  # s of prediction
         self.turn_rate = turn_rate

@@ -60,7 +60,7 @@ class DeployConfig:
     planner_period: float = 0.1  # s between commands
     max_steps: int | None = None  # agent steps (0.2 s) before the loop ends; None: until stopped
     max_duration: float | None = None  # s of loop clock before the loop ends (counts stopped time too)
-    end_distance: float | None = None  # end the run when D exceeds this (the real-world protocol: 3 m)
+    end_distance: float | None = None  # end the run when D exceeds this after having been within it (paper: 3 m)
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
 
 
@@ -110,6 +110,7 @@ class DeployLoop:
         self._started = False
         self._last_agent_t = -math.inf
         self._last_good = -math.inf
+        self._was_within = False
 
     # ------------------------------------------------------------------ one tick
     def _person_velocity(self, frame) -> np.ndarray:
@@ -198,7 +199,10 @@ class DeployLoop:
         if getattr(self.source, "finished", False):
             return "source_ended"
         if cfg.end_distance is not None and record.robot is not None:
-            if distance_and_alpha(record.robot, record.person)[0] > cfg.end_distance:
+            # the rule applies once the robot has been within the distance (a run may start farther)
+            distance = distance_and_alpha(record.robot, record.person)[0]
+            self._was_within = self._was_within or distance <= cfg.end_distance
+            if self._was_within and distance > cfg.end_distance:
                 return "too_far"
         if self.end_condition is not None:
             return self.end_condition() or ""

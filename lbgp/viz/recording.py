@@ -51,7 +51,12 @@ class EpisodeRecorder:
         self.path = Path(path) if path is not None else None
         self._tmp = None
         if spawn:
-            self.rec.spawn(connect=True)
+            try:
+                self.rec.spawn(connect=True)
+            except Exception as exc:  # no viewer installed or no display: keep recording to the file
+                import warnings
+
+                warnings.warn(f"could not open a live rerun viewer ({exc}); recording continues", stacklevel=2)
         if self.path is not None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._tmp = self.path.with_name(self.path.name + ".partial")

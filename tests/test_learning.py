@@ -56,7 +56,7 @@ def mean_return(policy, episodes=12, seed=1234):
 @pytest.mark.slow
 def test_short_training_learns_on_the_straight_level(tmp_path):
     # stay on the first curriculum level: unreachable thresholds and a budget as large as the run
-    cfg = D4PGConfig(seed=0, total_steps=10_000, level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(1.0, 1.0, 1.0))
+    cfg = D4PGConfig(seed=0, total_steps=10_000, level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(10.0, 10.0, 10.0))
     torch.manual_seed(cfg.seed)
     untrained = Actor(obs_lib.SIZE, 2, cfg.hidden)  # the learner's initial actor (same seed, same construction)
     summary = train(cfg, tmp_path / "run", backend="inline", progress=False)

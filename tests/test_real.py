@@ -92,6 +92,18 @@ def test_endpoint_urls_are_checked():
         open_source("udp://localhost:abc")
 
 
+def test_mocap_source_needs_the_motioncapture_extra():
+    try:
+        import motioncapture  # noqa: F401
+    except ImportError:
+        with pytest.raises(ImportError, match=r"pip install -e '\.\[mocap\]'"):
+            open_source("vicon://192.0.2.1")
+    else:  # pragma: no cover - only where the extra is installed (no mocap system to talk to here)
+        pytest.skip("motioncapture is installed; connecting needs a real system")
+    with pytest.raises(ValueError, match="name the mocap host"):
+        open_source("optitrack://")
+
+
 def test_ros2_sink_needs_rclpy():
     try:
         import rclpy  # noqa: F401

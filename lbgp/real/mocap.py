@@ -15,7 +15,7 @@ import numpy as np
 
 from lbgp.real.frames import PoseFrame
 
-SYSTEMS = ("vicon", "optitrack", "optitrack_closed_source", "qualisys", "vrpn", "motionanalysis", "nokov", "fzmotion")
+SYSTEMS = ("vicon", "optitrack", "optitrack_closed_source", "qualisys", "nokov", "vrpn", "motionanalysis")
 
 
 def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:

@@ -45,7 +45,8 @@ def plot_trajectories(panels: dict[str, dict], out: str | os.PathLike, title: st
             ax.plot(goals[:, 0], goals[:, 1], ".", color="tab:green", ms=3, label="goal")
         for path, color in ((person, "tab:blue"), (robot, "tab:orange")):
             ax.plot(*path[0, :2], "o", color=color, ms=6)
-            ax.quiver(path[::5, 0], path[::5, 1], np.cos(path[::5, 2]), np.sin(path[::5, 2]), color=color, scale=25, width=0.004)
+            ax.quiver(path[::5, 0], path[::5, 1], 0.3 * np.cos(path[::5, 2]), 0.3 * np.sin(path[::5, 2]), color=color,
+                      angles="xy", scale_units="xy", scale=1.0, width=0.005)
         ax.set_title(method)
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)

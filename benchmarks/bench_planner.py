@@ -12,7 +12,6 @@ process, two planner calls per agent step).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path

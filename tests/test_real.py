@@ -3,7 +3,6 @@ MCAP logs and replay, and hardware-in-the-loop with the simulated TurtleBot 2 in
 
 import json
 import math
-import os
 import select
 import signal
 import socket

@@ -16,7 +16,6 @@ person, whatever the policy wants.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 

@@ -85,3 +85,16 @@ def test_experiment_cli_checks_its_arguments(tmp_path):
         main(["experiment", "nonsense"])
     with pytest.raises(SystemExit):
         main(["experiment", "sim", "--episodes", "many"])
+
+
+@pytest.mark.parametrize("method", ["lbgp", "hc", "e2e"])
+def test_each_method_runs_every_scenario_for_a_short_seeded_episode(method):
+    from lbgp.evaluate import evaluate
+    from lbgp.sim.tasks import SCENARIOS
+
+    policy = make_policy(method)
+    rows = evaluate(policy, method, list(SCENARIOS), episodes=1, seed=3, horizon=4)
+    assert [r["scenario"] for r in rows] == list(SCENARIOS)
+    for r in rows:
+        assert r["method"] == method and 1 <= r["steps"] <= 4
+        assert np.isfinite(r["distance_mean"]) and np.isfinite(r["reward"])

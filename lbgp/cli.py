@@ -119,6 +119,7 @@ def cmd_deploy(args) -> int:
     try:
         loop = deploy(policy, source=args.source, sink=args.sink, robot=args.robot, steps=args.steps, log=args.log,
                       record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
+                      planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
                       metadata={"method": args.method, "policy": args.policy or "default"})
     except KeyboardInterrupt:
         print("interrupted: a zero command was sent")
@@ -271,6 +272,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--log", help="write an MCAP log (ROS 2 schemas, opens in Foxglove)")
     p.add_argument("--record", help="write a rerun recording (.rrd)")
     p.add_argument("--spawn", action="store_true", help="open a live rerun viewer")
+    p.add_argument("--planner-budget-ms", type=float, default=2.0,
+                   help="anytime SQP budget per planner call (default 2 ms, keeps pose-to-command latency p99 under 5 ms; 0: "
+                        "fixed iteration counts as in simulation)")
     p.add_argument("--json", help="write the run's summary here")
     p.set_defaults(func=cmd_deploy)
 

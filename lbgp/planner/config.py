@@ -46,6 +46,8 @@ class PlannerConfig:
     sqp_iterations: int = 2  # iterations when warm-started (the band also keeps improving from call
     # to call, as in real-time-iteration MPC; 2 plans clearly better than 1 around a walking person)
     sqp_iterations_init: int = 6  # iterations after a (re)initialisation
+    sqp_time_budget: float | None = None  # s: anytime mode (deployment): no further SQP iteration once it would
+    # end past this budget (at least one always runs); None: the fixed counts above (simulation, reproducible)
     trust_region_position: float = 0.4  # m per iteration
     trust_region_heading: float = 0.8  # rad per iteration
     step_tolerance: float = 1e-3  # stop early when the step is this small

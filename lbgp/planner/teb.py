@@ -183,7 +183,13 @@ class TebPlanner:
         iterations = cfg.sqp_iterations if warm else cfg.sqp_iterations_init
         scale = float(np.linalg.norm(goal[:2] - robot_pose[:2])) + 1.0
         status, done = OK, 0
+        t_loop = time.perf_counter()
         for done in range(1, iterations + 1):
+            if cfg.sqp_time_budget is not None and done > 1:
+                spent = time.perf_counter() - t_start
+                if spent + (time.perf_counter() - t_loop) / (done - 1) > cfg.sqp_time_budget:
+                    done -= 1
+                    break  # anytime: the band keeps improving from the next call (warm start)
             band.dt = self._timing(band, v_now, w_now, goal_speed)
             goal_then = np.r_[goal[:2] + goal_vel * band.times[-1], goal[2]]
             step, status = self._sqp_step(band, goal_then, person_pose[:2], person_vel)

@@ -8,7 +8,7 @@ from lbgp.real.loop import DeployConfig, DeployLoop
 
 def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
            log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
-           end_distance: float | None = None, metadata: dict | None = None):
+           end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None):
     """Run the loop until ``steps`` agent steps (or the source ends, or Ctrl-C); returns the loop
     (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``)."""
     pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance)
@@ -24,7 +24,8 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
 
             recorder = EpisodeRecorder(record, spawn=spawn_viewer)
         end_condition = (lambda: "contact" if world.contact else None) if world is not None else None
-        loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance),
+        loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance,
+                                                                                 planner_time_budget=planner_time_budget),
                           logger=logger, recorder=recorder, end_condition=end_condition)
         loop.world = world
         loop.run()

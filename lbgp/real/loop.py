@@ -39,6 +39,7 @@ from lbgp.sim.robots import get_robot
 from lbgp.world import WorldState
 
 SHUTDOWN = "shutdown"
+DEPLOY_DEFAULT_BUDGET = 0.002  # s of SQP per planner call in ``lbgp deploy`` (see docs/deploy.md, "Latency")
 
 
 class WallClock:
@@ -60,6 +61,7 @@ class DeployConfig:
     planner_period: float = 0.1  # s between commands
     max_steps: int | None = None  # agent steps (0.2 s) before the loop ends; None: until stopped
     max_duration: float | None = None  # s of loop clock before the loop ends (counts stopped time too)
+    planner_time_budget: float | None = None  # s: anytime SQP budget per planner call (None: as in simulation)
     end_distance: float | None = None  # end the run when D exceeds this after having been within it (paper: 3 m)
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
 
@@ -92,7 +94,7 @@ class DeployLoop:
         self.clock = clock or getattr(source, "clock", None) or WallClock()
         self.logger, self.recorder = logger, recorder
         self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
-        self.limits = planner_config_for(get_robot(self.cfg.robot))
+        self.limits = dataclasses.replace(planner_config_for(get_robot(self.cfg.robot)), sqp_time_budget=self.cfg.planner_time_budget)
         if policy.control == "goal":
             self.controller = GoalController(TebPlanner(self.limits))
         else:

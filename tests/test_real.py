@@ -400,3 +400,22 @@ def test_hardware_in_the_loop_over_loopback_follows_ahead():
     assert metrics.total_reward > reference.total_reward - 3.0, (metrics.total_reward, reference.total_reward)
     assert server.received and server.received[-1][1:] == (0.0, 0.0, SHUTDOWN)
     assert not server.world.contact
+
+
+def test_planner_safe_stop_reaches_the_robot_with_its_status():
+    sent = []
+
+    class Sink:
+        def send(self, t, v, w, status="ok"):
+            sent.append((status, v, w))
+
+    clock = ReplayClock()
+
+    class Source:
+        def poll(self, now, timeout=0.0):
+            return [frame(now, [-1.5, 0, 0], [0, 0, 0], received=now)]
+
+    # a goal right on the person: the planner refuses it (its safe stop), whatever the data says
+    DeployLoop(Source(), Sink(), ConstantGoalPolicy((0.0, 0.0)), DeployConfig(max_steps=3), clock=clock).run()
+    assert [s for s, _, _ in sent[:-1]] == ["goal_in_collision"] * (len(sent) - 1)
+    assert all(v == 0.0 and w == 0.0 for _, v, w in sent)

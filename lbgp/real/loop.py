@@ -109,7 +109,6 @@ class DeployLoop:
         self.agent_steps = 0
         self.end_reason = ""
         self._people: collections.deque = collections.deque(maxlen=64)  # (t, person pose) accepted
-        self._started = False
         self._last_agent_t = -math.inf
         self._last_good = -math.inf
         self._was_within = False
@@ -164,7 +163,8 @@ class DeployLoop:
         else:
             v, w = self._stop_command()
         self.command = (v, w)
-        self.sink.send(now, v, w, status)
+        # the robot side sees why it is being stopped: a safety reason, or the planner's safe stop
+        self.sink.send(now, v, w, status if record.planner_status in ("", safety_lib.OK) else record.planner_status)
         record.v, record.w = v, w
         if frames:
             record.latency_s = time.perf_counter() - t_read

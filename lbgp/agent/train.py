@@ -49,9 +49,10 @@ def _write_json(path: Path, data) -> None:
     os.replace(tmp, path)
 
 
-def read_curve(path: Path) -> list[dict]:
+def read_curve(path: str | os.PathLike) -> list[dict]:
     """Rows of a curve.csv; a half-written last line (killed run) is ignored."""
     rows = []
+    path = Path(path)
     if not path.is_file():
         return rows
     with path.open(newline="") as f:

@@ -31,6 +31,26 @@ def frame(t, robot, person, received=None):
     return PoseFrame(t, np.asarray(robot, float), np.asarray(person, float), t if received is None else received)
 
 
+class ListSink:
+    """Records every command the loop sends (status, v, w)."""
+
+    def __init__(self):
+        self.sent = []
+
+    def send(self, t, v, w, status="ok"):
+        self.sent.append((status, v, w))
+
+
+class FixedPoses:
+    """A pose source that reports the same robot and person poses at every tick."""
+
+    def __init__(self, robot, person):
+        self.robot, self.person = robot, person
+
+    def poll(self, now, timeout=0.0):
+        return [frame(now, self.robot, self.person, received=now)]
+
+
 # ---------------------------------------------------------------- frames and safety rules
 def test_pose_datagrams_round_trip_and_malformed_ones_are_named():
     f = decode_frame(encode_frame(frame(1.5, [1, 2, 0.3], [0, 0, 0])))
@@ -260,21 +280,10 @@ def test_ctrl_c_or_an_exception_sends_a_zero_command_before_exit(error):
                 raise error("stop")
             return np.array([1.0, 0.0], np.float32)
 
-    sent = []
-
-    class Sink:
-        def send(self, t, v, w, status="ok"):
-            sent.append((status, v, w))
-
-    clock = ReplayClock()
-
-    class Source:
-        def poll(self, now, timeout=0.0):
-            return [frame(now, [0, 0, 0], [-1.5, 0, 0], received=now)]
-
+    sink = ListSink()
     with pytest.raises(error):
-        DeployLoop(Source(), Sink(), Failing(), DeployConfig(), clock=clock).run()
-    assert sent[-2][1] > 0 and sent[-1] == (SHUTDOWN, 0.0, 0.0)
+        DeployLoop(FixedPoses([0, 0, 0], [-1.5, 0, 0]), sink, Failing(), DeployConfig(), clock=ReplayClock()).run()
+    assert sink.sent[-2][1] > 0 and sink.sent[-1] == (SHUTDOWN, 0.0, 0.0)
 
 
 # ---------------------------------------------------------------- simulated robot, MCAP logs, replay
@@ -403,19 +412,8 @@ def test_hardware_in_the_loop_over_loopback_follows_ahead():
 
 
 def test_planner_safe_stop_reaches_the_robot_with_its_status():
-    sent = []
-
-    class Sink:
-        def send(self, t, v, w, status="ok"):
-            sent.append((status, v, w))
-
-    clock = ReplayClock()
-
-    class Source:
-        def poll(self, now, timeout=0.0):
-            return [frame(now, [-1.5, 0, 0], [0, 0, 0], received=now)]
-
+    sink = ListSink()
     # a goal right on the person: the planner refuses it (its safe stop), whatever the data says
-    DeployLoop(Source(), Sink(), ConstantGoalPolicy((0.0, 0.0)), DeployConfig(max_steps=3), clock=clock).run()
-    assert [s for s, _, _ in sent[:-1]] == ["goal_in_collision"] * (len(sent) - 1)
-    assert all(v == 0.0 and w == 0.0 for _, v, w in sent)
+    DeployLoop(FixedPoses([-1.5, 0, 0], [0, 0, 0]), sink, ConstantGoalPolicy((0.0, 0.0)), DeployConfig(max_steps=3), clock=ReplayClock()).run()
+    assert [s for s, _, _ in sink.sent[:-1]] == ["goal_in_collision"] * (len(sink.sent) - 1)
+    assert all(v == 0.0 and w == 0.0 for _, v, w in sink.sent)

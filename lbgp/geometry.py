@@ -58,6 +58,11 @@ def distance_and_alpha(robot_pose, person_pose) -> tuple[float, float]:
     return math.hypot(x, y), math.atan2(y, x)
 
 
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Rotation about the vertical axis (rad) of a unit quaternion (x, y, z, w), z up."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
 def pose_from_polar(person_pose, distance: float, alpha: float, relative_yaw: float = 0.0) -> np.ndarray:
     """World pose at ``distance`` and angle ``alpha`` from the person, heading person yaw + relative_yaw."""
     rel = np.array([distance * math.cos(alpha), distance * math.sin(alpha), relative_yaw])

@@ -62,22 +62,10 @@ def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, dist
     """One run of the protocol through the deployment loop; returns its EpisodeMetrics."""
     world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting])
     source = SimPoseSource(world, disturbance if disturbance is not None else MocapDisturbance(), seed=seed)
-    if collector is not None:
-        collector.begin_episode(f"{path}/{setting}")
-
-    class _Collect:  # the loop's recorder interface, kept in memory for the pictures
-        def begin_episode(self, name, index=0):
-            pass
-
-        def log_step(self, info, reward=None):
-            collector.log_step(info, reward)
-
     loop = DeployLoop(source, SimCommandSink(world), policy, DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE),
-                      recorder=_Collect() if collector is not None else None, end_condition=lambda: "contact" if world.contact else None,
-                      keep_records=False)
-    metrics = loop.run()
-    metrics.setting = f"{path}/{setting}"
-    return metrics
+                      recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=False,
+                      name=f"{path}/{setting}")
+    return loop.run()
 
 
 def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods=METHODS, paths=None, policies=None,

@@ -27,7 +27,6 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
         loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance,
                                                                                  planner_time_budget=planner_time_budget),
                           logger=logger, recorder=recorder, end_condition=end_condition)
-        loop.world = world
         loop.run()
         return loop
     finally:

@@ -83,12 +83,12 @@ class TickRecord:
     planner_status: str = ""
     latency_s: float = math.nan  # from reading the newest frame to sending the command
     reward: float = math.nan  # agent steps only
-    distance_alpha: tuple = (math.nan, math.nan)
+    distance_alpha: tuple = (math.nan, math.nan)  # whenever the tick had good poses
 
 
 class DeployLoop:
     def __init__(self, source, sink, policy, config: DeployConfig | None = None, clock=None, logger=None,
-                 recorder=None, end_condition=None, keep_records: bool = True):
+                 recorder=None, end_condition=None, keep_records: bool = True, name: str = "deploy"):
         self.cfg = config or DeployConfig()
         self.source, self.sink, self.policy = source, sink, policy
         self.clock = clock or getattr(source, "clock", None) or WallClock()
@@ -102,7 +102,8 @@ class DeployLoop:
         self.monitor = SafetyMonitor(self.cfg.safety)
         self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance
         self.stack = obs_lib.ObservationStack()
-        self.metrics = EpisodeMetrics(setting="deploy")
+        self.name = name  # the run's name in the metrics and the recording
+        self.metrics = EpisodeMetrics(setting=name)
         self.records: list[TickRecord] | None = [] if keep_records else None
         self.command = (0.0, 0.0)
         self.ticks = 0
@@ -140,7 +141,7 @@ class DeployLoop:
             if not self._people or self._people[-1][0] < frame.t:
                 self._people.append((frame.t, frame.person.copy()))
             record.robot, record.person = frame.robot.copy(), frame.person.copy()
-            distance, alpha = distance_and_alpha(frame.robot, frame.person)
+            distance, alpha = record.distance_alpha = distance_and_alpha(frame.robot, frame.person)
             if distance < self.min_distance:
                 status = record.status = safety_lib.TOO_CLOSE
         if status == safety_lib.OK:
@@ -189,7 +190,6 @@ class DeployLoop:
         record.agent_step = True
         record.observation = observation
         record.reward = reward
-        record.distance_alpha = (distance, alpha)
 
     # ------------------------------------------------------------------ the loop
     def _finished(self, record: TickRecord) -> str:
@@ -202,7 +202,7 @@ class DeployLoop:
             return "source_ended"
         if cfg.end_distance is not None and record.robot is not None:
             # the rule applies once the robot has been within the distance (a run may start farther)
-            distance = distance_and_alpha(record.robot, record.person)[0]
+            distance = record.distance_alpha[0]
             self._was_within = self._was_within or distance <= cfg.end_distance
             if self._was_within and distance > cfg.end_distance:
                 return "too_far"
@@ -215,7 +215,7 @@ class DeployLoop:
         period = self.cfg.planner_period
         next_tick = self._start_t = self.clock.now()
         if self.recorder is not None:
-            self.recorder.begin_episode("deploy")
+            self.recorder.begin_episode(self.name)
         try:
             while True:
                 self.clock.sleep_until(next_tick)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lbgp.geometry import yaw_from_quaternion
 from lbgp.real.frames import PoseFrame
 
 LOG_METADATA = "lbgp"
@@ -73,10 +74,6 @@ def _pose_msg(pose, ns: int) -> dict:
     return {"header": {"stamp": _stamp(ns), "frame_id": "world"},
             "pose": {"position": {"x": x, "y": y, "z": 0.0},
                      "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2), "w": math.cos(yaw / 2)}}}
-
-
-def _yaw(q: dict) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class McapLogger:
@@ -168,7 +165,8 @@ def read_log(path: str | os.PathLike) -> dict:
 
 
 def pose_of(msg) -> np.ndarray:
-    return np.array([msg.pose.position.x, msg.pose.position.y, _yaw(msg.pose.orientation)])
+    q = msg.pose.orientation
+    return np.array([msg.pose.position.x, msg.pose.position.y, yaw_from_quaternion(q.x, q.y, q.z, q.w)])
 
 
 def frames_of(log: dict) -> list[PoseFrame]:

@@ -6,20 +6,16 @@ Yaw is the rotation about the vertical (z) axis of the mocap frame; set the syst
 
 from __future__ import annotations
 
-import math
 import queue
 import threading
 import time
 
 import numpy as np
 
+from lbgp.geometry import yaw_from_quaternion
 from lbgp.real.frames import PoseFrame
 
 SYSTEMS = ("vicon", "optitrack", "optitrack_closed_source", "qualisys", "nokov", "vrpn", "motionanalysis")
-
-
-def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 class MocapPoseSource:

@@ -18,7 +18,7 @@ from dm_control.rl import control
 from dm_env import specs
 
 from lbgp.control import Command, GoalController, VelocityController
-from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar
+from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar, yaw_from_quaternion
 from lbgp.planner import TebPlanner, planner_config_for
 from lbgp.sim import observation as obs_lib
 from lbgp.sim import paths as path_lib
@@ -74,7 +74,7 @@ class Physics(dm_mujoco.Physics):
         if self._pose_time == data.time and self._pose_cache is not None:
             return self._pose_cache.copy()  # already computed for this physics state
         q = data.qpos[self.qpos_adr : self.qpos_adr + 7]
-        yaw = math.atan2(2.0 * (q[3] * q[6] + q[4] * q[5]), 1.0 - 2.0 * (q[5] ** 2 + q[6] ** 2))
+        yaw = yaw_from_quaternion(q[4], q[5], q[6], q[3])  # MuJoCo stores (w, x, y, z)
         self._pose_cache, self._pose_time = np.array([q[0], q[1], yaw]), data.time
         return self._pose_cache.copy()
 

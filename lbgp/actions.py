@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+DESIRED_GOAL = (1.5, 0.0)  # m, person frame: where the reward peaks (D = 1.5 m, alpha = 0)
 GOAL_X = (-1.0, 3.0)  # m, person frame
 GOAL_Y = (-2.0, 2.0)  # m, person frame
 MAX_V = 1.0  # m/s

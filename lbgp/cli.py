@@ -39,7 +39,7 @@ def cmd_demo(args) -> int:
     out = Path(args.out)
     policy_file = Path(args.policy) if args.policy else default_policy_path()
     if args.scripted:
-        policy, policy_name = ConstantGoalPolicy((1.5, 0.0)), "scripted goal 1.5 m ahead of the person"
+        policy, policy_name = ConstantGoalPolicy(), "scripted goal 1.5 m ahead of the person"
     elif policy_file.is_file():
         from lbgp.agent import load_policy
 
@@ -47,7 +47,7 @@ def cmd_demo(args) -> int:
     elif args.policy:
         raise FileNotFoundError(f"{policy_file}: no such policy file")
     else:
-        policy, policy_name = ConstantGoalPolicy((1.5, 0.0)), "scripted goal 1.5 m ahead of the person (no pretrained policy found)"
+        policy, policy_name = ConstantGoalPolicy(), "scripted goal 1.5 m ahead of the person (no pretrained policy found)"
     print(f"lbgp demo: robot={args.robot} seed={args.seed} policy: {policy_name}")
     rows = []
     with EpisodeRecorder(out / "demo.rrd") as recorder:
@@ -102,6 +102,7 @@ def cmd_train(args) -> int:
             method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
             num_actors=args.actors,
+            prior_weight=D4PGConfig.prior_weight if args.prior_weight is None else args.prior_weight,
         ).validate()
         summary = train(cfg, args.out, backend=args.backend)
     print(json.dumps(summary, indent=2))
@@ -226,6 +227,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--minutes", type=float, default=None, help="also stop after this much wall time")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--actors", type=int, default=4, help="actor processes (one of them exploits)")
+    p.add_argument("--prior-weight", type=float, default=None,
+                   help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; 0: plain D4PG)")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],
                    help="processes: actor processes (default); inline: one process, reproducible; ray: Ray tasks (extra)")
     p.add_argument("--out", help="run directory (created)")

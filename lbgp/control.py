@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from lbgp.actions import goal_from_action, velocity_from_action
+from lbgp.actions import DESIRED_GOAL, goal_from_action, velocity_from_action
 from lbgp.geometry import from_frame
 from lbgp.planner import OK, Plan, PlannerConfig, TebPlanner, clamp_command
 from lbgp.world import WorldState
@@ -60,11 +60,11 @@ class GoalController:
 
     def __init__(self, planner: TebPlanner):
         self.planner = planner
-        self.goal_person = np.array([1.5, 0.0])
+        self.goal_person = np.array(DESIRED_GOAL)
 
     def reset(self) -> None:
         self.planner.reset()
-        self.goal_person = np.array([1.5, 0.0])
+        self.goal_person = np.array(DESIRED_GOAL)
 
     def set_action(self, action, state: WorldState) -> None:
         self.set_goal(goal_from_action(action))

@@ -40,5 +40,5 @@ def make_policy(method: str, policy_file=None, hc_distance: float | None = None,
     if method == "scripted":
         from lbgp.rollout import ConstantGoalPolicy
 
-        return ConstantGoalPolicy((1.5, 0.0))
+        return ConstantGoalPolicy()
     raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")

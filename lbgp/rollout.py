@@ -18,10 +18,10 @@ class ConstantGoalPolicy:
 
     control = "goal"
 
-    def __init__(self, goal_xy=(1.5, 0.0)):
-        from lbgp.actions import action_from_goal
+    def __init__(self, goal_xy=None):
+        from lbgp.actions import DESIRED_GOAL, action_from_goal
 
-        self.action = action_from_goal(goal_xy).astype(np.float32)
+        self.action = action_from_goal(DESIRED_GOAL if goal_xy is None else goal_xy).astype(np.float32)
 
     def reset(self) -> None:
         pass

@@ -184,3 +184,43 @@ def test_config_validation():
         D4PGConfig(method="ppo").validate()
     with pytest.raises(ValueError, match="unknown training config keys"):
         D4PGConfig.from_dict({"learning_rate": 1})
+
+
+def _actor_steps(method, prior_weight, steps=50):
+    """Train only the actor against a critic that is indifferent to the action (all-zero weights:
+    uniform atoms, Q = 0 everywhere): only the goal prior can move the actions."""
+    from lbgp.agent.learner import D4PGLearner
+    from lbgp.sim import observation as obs_lib
+
+    torch.manual_seed(0)
+    learner = D4PGLearner(D4PGConfig(method=method, prior_weight=prior_weight, actor_lr=1e-2), obs_lib.SIZE, 2)
+    with torch.no_grad():
+        for p in learner.critic.parameters():
+            p.zero_()
+    obs = torch.rand(64, obs_lib.SIZE) * 2 - 1
+    before = learner.actor(obs).detach()
+    for _ in range(steps):
+        loss, _ = learner.actor_loss(obs)
+        learner.actor_opt.zero_grad()
+        loss.backward()
+        learner.actor_opt.step()
+    return before, learner.actor(obs).detach(), learner.prior
+
+
+def test_goal_prior_pulls_lbgp_actions_to_the_goal_ahead_and_nothing_else_moves_them():
+    from lbgp.actions import goal_from_action
+
+    before, after, prior = _actor_steps("lbgp", 1.0)
+    assert np.allclose(goal_from_action(prior.numpy()), [1.5, 0.0])
+    gap_before = (before - prior).norm(dim=1).mean()
+    gap_after = (after - prior).norm(dim=1).mean()
+    assert gap_after < 0.2 * gap_before
+    # no prior (plain D4PG) or E2E (wheel commands have no prior): an indifferent critic leaves the actor be
+    for method, weight in (("lbgp", 0.0), ("e2e", 1.0)):
+        before, after, _ = _actor_steps(method, weight)
+        assert torch.allclose(before, after)
+
+
+def test_negative_prior_weight_is_refused():
+    with pytest.raises(ValueError, match="prior_weight"):
+        D4PGConfig(prior_weight=-1.0).validate()

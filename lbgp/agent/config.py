@@ -39,6 +39,9 @@ class D4PGConfig:
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
     target_tau: float = 0.0  # > 0: soft (Polyak) target update by this much every step instead of hard updates
+    prior_weight: float = 1.0  # LBGP only (not in the paper): the actor loss adds this * |a - a_ahead|^2,
+    # a_ahead = the goal 1.5 m ahead. Keeps goals near the sensible default wherever the critic has no
+    # clear preference (without it the goals jump step to step); 0 = plain D4PG. E2E: always 0.
     num_atoms: int = 51  # (acme)
     v_min: float = -30.0  # acme [-150, 150] is for rewards ~1/step over 1000 steps; here rewards are in
     v_max: float = 30.0  # [-1, 1] and 1 / (1 - 0.97) = 33: +-30 covers every discounted return
@@ -65,6 +68,8 @@ class D4PGConfig:
             raise ValueError(f"need 1+ actors and at most that many exploiting ones, got {self.num_actors}/{self.num_exploit}")
         if self.v_min >= self.v_max or self.num_atoms < 2:
             raise ValueError("the value support needs v_min < v_max and at least 2 atoms")
+        if not self.prior_weight >= 0:
+            raise ValueError(f"prior_weight must be >= 0, got {self.prior_weight}")
         if self.n_step < 1 or not 0 < self.discount <= 1:
             raise ValueError("n_step must be >= 1 and discount in (0, 1]")
         return self

@@ -7,6 +7,7 @@ import copy
 import torch
 import torch.nn.functional as F
 
+from lbgp.actions import DESIRED_GOAL, action_from_goal
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.distributional import categorical_projection
 from lbgp.agent.networks import Actor, DistributionalCritic
@@ -22,6 +23,9 @@ class D4PGLearner:
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
         self.updates = 0
+        # LBGP's goal prior (cfg.prior_weight): the goal 1.5 m straight ahead of the person
+        self.prior = torch.as_tensor(action_from_goal(DESIRED_GOAL), dtype=torch.float32)
+        self.prior_weight = cfg.prior_weight if cfg.method == "lbgp" else 0.0
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         obs, action = batch["obs"], batch["action"]
@@ -37,9 +41,7 @@ class D4PGLearner:
         torch.nn.utils.clip_grad_norm_(self.critic.parameters(), self.cfg.grad_clip)
         self.critic_opt.step()
 
-        # actor: deterministic policy gradient through the critic's expected value
-        q = self.critic.q_value(obs, self.actor(obs))
-        actor_loss = -q.mean()
+        actor_loss, q = self.actor_loss(obs)
         self.actor_opt.zero_grad(set_to_none=True)
         actor_loss.backward()
         torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
@@ -54,6 +56,15 @@ class D4PGLearner:
             self.target_actor.load_state_dict(self.actor.state_dict())
             self.target_critic.load_state_dict(self.critic.state_dict())
         return {"critic_loss": float(critic_loss.detach()), "actor_loss": float(actor_loss.detach()), "q": float(q.detach().mean())}
+
+    def actor_loss(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Deterministic policy gradient through the critic's expected value, plus (LBGP) the goal prior."""
+        action = self.actor(obs)
+        q = self.critic.q_value(obs, action)
+        loss = -q.mean()
+        if self.prior_weight > 0:
+            loss = loss + self.prior_weight * ((action - self.prior) ** 2).sum(-1).mean()
+        return loss, q
 
     def state_dict(self) -> dict:
         return {

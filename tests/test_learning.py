@@ -10,10 +10,11 @@ luck of the draw. The random-spawn level itself is too noisy to judge 10,000 ste
 down for seed 2).
 
 Measured (`python benchmarks/learning_seeds.py --seeds 0,1,2,3`, results/learning_seeds.json;
-straight_ahead return, 35 steps, as judged here): trained 16.5 / 15.7 / 11.1 / 11.0 for seeds
-0-3, untrained 2.5 / 7.5 / 4.6 / 2.7, random policy 6.5. The bounds below hold for seeds 0 and 1
-but not 2 and 3: the check is deterministic for its seed, not robust across seeds. For scale, a
-constant goal 1.5 m ahead scores 25.6 and the shipped 30-minute LBGP policy 17.7.
+straight_ahead return, 35 steps, as judged here): trained 15.9 / 21.0 / 18.3 / 21.3 for seeds
+0-3, untrained 2.5 / 7.5 / 4.6 / 2.7, random policy 6.5: the bounds below hold for all four seeds
+(without the goal prior, `prior_weight=0`, the trained returns were 16.5 / 15.7 / 11.1 / 11.0 and
+seeds 2 and 3 failed). For scale, a constant goal 1.5 m ahead scores 25.6 and the shipped
+30-minute LBGP policy 22.1.
 """
 
 import numpy as np

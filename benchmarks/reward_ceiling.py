@@ -1,4 +1,4 @@
-"""An upper bound on the mean 35-step return any policy can reach on the straight and circles levels.
+"""An upper bound on the mean 35-step return any policy can reach on each training level.
 
     python benchmarks/reward_ceiling.py --json results/reward_ceiling.json
 
@@ -8,9 +8,10 @@ footprint) and that only has to respect the episode's end conditions at the 5 Hz
 Whatever a real robot with the same top speed does, this point can do too, so the best return of
 the point is at least the best return of any policy.
 
-For one person motion (straight at v, or a circle with v and w) the relative motion of the point in
-the person frame is the same for every episode, so the best return from each start is a dynamic
-program over a grid of person-frame positions (``h`` metres apart), 35 steps back from the end:
+For one episode's person motion (straight at v; a circle with v and w; or, on the smoothed and
+trajectories levels, the (v, w) sequence of a sampled episode of the level's own motion model) the
+best return of the point from every start is a dynamic program over a grid of person-frame
+positions (``h`` metres apart), 35 steps back from the end:
 
     V_k(p) = max over |u| <= vmax of  R(p') + [p' not terminal] * V_{k+1}(p'),
     p' = Rot(-w dt) (p + u dt - d),   d = the person's displacement during the step.
@@ -18,7 +19,8 @@ program over a grid of person-frame positions (``h`` metres apart), 35 steps bac
 The max over the disc of u is a grey dilation (``scipy.ndimage.maximum_filter`` with a disc
 footprint, radius rounded up), V_{k+1} at p' is read by linear interpolation, R and the end
 conditions at p' are exact. V_0 is then averaged over the level's start distribution (distance
-uniform in [1, 2.5] m, direction uniform, person speeds on a midpoint grid over their ranges).
+uniform in [1, 2.5] m, direction uniform) and person motions (straight and circles: speeds on a
+midpoint grid over their ranges; smoothed and trajectories: 40 sampled episodes).
 Grid effects are reported by running two grid sizes.
 """
 
@@ -36,12 +38,12 @@ from scipy import ndimage
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
 
-from lbgp.sim.rewards import follow_ahead_reward, out_of_range  # noqa: E402
-from lbgp.sim.tasks import CONTROL_PERIOD, DEFAULT_HORIZON  # noqa: E402
+from lbgp.geometry import integrate_unicycle  # noqa: E402
+from lbgp.sim.rewards import MAX_DISTANCE, MIN_DISTANCE, follow_ahead_reward_array  # noqa: E402
+from lbgp.sim.tasks import CONTROL_PERIOD, DEFAULT_HORIZON, LEVELS  # noqa: E402
 
-EXTENT = 5.4  # m (1.5 m ahead is a grid point for h = 0.06, 0.03): the grid covers [-EXTENT, EXTENT]^2 in the person frame (D > 5 ends an episode)
-_reward = np.vectorize(lambda x, y: follow_ahead_reward(math.hypot(x, y), math.atan2(y, x)))
-_ends = np.vectorize(lambda x, y: out_of_range(math.hypot(x, y)))
+EXTENT = 5.4  # m (1.5 m ahead is a grid point for h = 0.06, 0.046, 0.03): the grid covers [-EXTENT, EXTENT]^2
+# in the person frame (D > 5 ends an episode)
 
 
 class Grid:
@@ -54,26 +56,52 @@ class Grid:
         return np.stack([(x + EXTENT) / self.h, (y + EXTENT) / self.h])
 
 
-def best_returns(grid: Grid, v: float, w: float, vmax: float, steps: int = DEFAULT_HORIZON, dt: float = CONTROL_PERIOD):
-    """V_0 on the grid for a person walking at (v, w): the relaxed robot's best return from each start."""
-    if abs(w) < 1e-9:
-        dx, dy, turn = v * dt, 0.0, 0.0
-    else:
-        dx, dy, turn = v / w * math.sin(w * dt), v / w * (1.0 - math.cos(w * dt)), w * dt
-    c, s = math.cos(turn), math.sin(turn)
-    qx, qy = grid.x - dx, grid.y - dy
-    px, py = c * qx + s * qy, -s * qx + c * qy  # where a point at q (after the robot's move) lands
-    reward, ends = _reward(px, py), _ends(px, py)
-    coords = grid.index(px, py)
+class StepModel:
+    """One agent step of a person walking at (v, w): where each grid point lands, its reward and end."""
+
+    def __init__(self, grid: Grid, v: float, w: float, dt: float):
+        if abs(w) < 1e-9:
+            dx, dy, turn = v * dt, 0.0, 0.0
+        else:
+            dx, dy, turn = v / w * math.sin(w * dt), v / w * (1.0 - math.cos(w * dt)), w * dt
+        c, s = math.cos(turn), math.sin(turn)
+        qx, qy = grid.x - dx, grid.y - dy
+        px, py = c * qx + s * qy, -s * qx + c * qy  # where a point at q (after the robot's move) lands
+        distance = np.hypot(px, py)
+        self.reward = follow_ahead_reward_array(distance, np.arctan2(py, px))
+        self.ends = (distance < MIN_DISTANCE) | (distance > MAX_DISTANCE)
+        self.coords = grid.index(px, py)
+
+
+def best_returns(grid: Grid, motions, vmax: float, dt: float = CONTROL_PERIOD):
+    """V_0 on the grid: the relaxed robot's best return from each start, for a person who walks
+    ``motions[k] = (v, w)`` during step k (one entry per agent step of the episode)."""
+    models: dict[tuple, StepModel] = {}
     radius = vmax * dt / grid.h
     r = int(math.ceil(radius))
     ox, oy = np.mgrid[-r : r + 1, -r : r + 1]
     footprint = ox**2 + oy**2 <= (radius + 0.5) ** 2  # rounded up: never smaller than the true disc
     value = np.zeros_like(grid.x)
-    for _ in range(steps):
-        after = reward + np.where(ends, 0.0, ndimage.map_coordinates(value, coords, order=1, mode="nearest"))
+    for v, w in reversed(motions):
+        key = (round(v, 9), round(w, 9))
+        if key not in models:
+            models[key] = StepModel(grid, v, w, dt)
+        m = models[key]
+        after = m.reward + np.where(m.ends, 0.0, ndimage.map_coordinates(value, m.coords, order=1, mode="nearest"))
         value = ndimage.maximum_filter(after, footprint=footprint, mode="nearest")
     return value
+
+
+def person_commands(setting_name: str, rng: np.random.Generator, steps: int = DEFAULT_HORIZON, dt: float = CONTROL_PERIOD):
+    """The (v, w) a level's person walks in each step of one episode (the simulator's motion model)."""
+    motion = LEVELS[setting_name].motion()
+    pose = motion.reset(rng, np.zeros(3))
+    commands = []
+    for _ in range(steps):
+        v, w = motion.command(pose, dt)
+        commands.append((float(v), float(w)))
+        pose = integrate_unicycle(pose, v, w, dt)
+    return commands
 
 
 def start_points(n: int, rng: np.random.Generator):
@@ -86,18 +114,19 @@ def midpoints(lo: float, hi: float, n: int) -> np.ndarray:
     return lo + (np.arange(n) + 0.5) * (hi - lo) / n
 
 
-def level_ceiling(grid: Grid, level: str, vmax: float, starts: int = 4000, bins: int = 6) -> dict:
+def level_ceiling(grid: Grid, level: str, vmax: float, starts: int = 4000, bins: int = 6, episodes: int = 40) -> dict:
     rng = np.random.default_rng(0)
     x, y, alpha = start_points(starts, rng)
+    steps = DEFAULT_HORIZON
     if level == "straight":
-        motions = [(v, 0.0) for v in midpoints(0.3, 1.0, bins)]
+        motions = [[(v, 0.0)] * steps for v in midpoints(0.3, 1.0, bins)]
     elif level == "circles":  # w < 0 is the mirror image of w > 0, same start distribution
-        motions = [(v, w) for v in midpoints(0.2, 0.6, bins // 2 + 1) for w in midpoints(0.3, 0.8, bins // 2 + 1)]
-    else:
-        raise ValueError(level)
+        motions = [[(v, w)] * steps for v in midpoints(0.2, 0.6, bins // 2 + 1) for w in midpoints(0.3, 0.8, bins // 2 + 1)]
+    else:  # a sample of episodes of the level's own person motion
+        motions = [person_commands(level, rng) for _ in range(episodes)]
     per_start = []
-    for v, w in motions:
-        value = best_returns(grid, v, w, vmax)
+    for motion in motions:
+        value = best_returns(grid, motion, vmax)
         per_start.append(ndimage.map_coordinates(value, grid.index(x, y), order=1))
     per_start = np.mean(per_start, axis=0)
     behind = np.abs(alpha) > math.pi / 2
@@ -108,21 +137,22 @@ def level_ceiling(grid: Grid, level: str, vmax: float, starts: int = 4000, bins:
         "mean_bound": float(per_start.mean()),
         "mean_bound_starts_in_front_half": float(per_start[~behind].mean()),
         "mean_bound_starts_in_back_half": float(per_start[behind].mean()),
-        "motions": len(motions),
+        "person_motions": len(motions),
     }
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", default="results/reward_ceiling.json")
-    parser.add_argument("--grids", default="0.06,0.03", help="grid spacings in metres (comma separated)")
+    parser.add_argument("--grids", default="0.06,0.046", help="grid spacings in metres (comma separated; 1.5 m ahead should be a grid point)")
     parser.add_argument("--vmax", default="1.5,2.0", help="top speeds in m/s (Jackal planner limit, Jackal spec)")
+    parser.add_argument("--levels", default="straight,circles,smoothed,trajectories")
     args = parser.parse_args()
     results = []
     for h in (float(g) for g in args.grids.split(",")):
         grid = Grid(h)
         for vmax in (float(v) for v in args.vmax.split(",")):
-            for level in ("straight", "circles"):
+            for level in args.levels.split(","):
                 t0 = time.perf_counter()
                 row = level_ceiling(grid, level, vmax)
                 row["seconds"] = round(time.perf_counter() - t0, 1)

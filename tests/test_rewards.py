@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from lbgp.sim.rewards import distance_reward, follow_ahead_reward, orientation_reward, out_of_range
+from lbgp.sim.rewards import distance_reward, follow_ahead_reward, follow_ahead_reward_array, orientation_reward, out_of_range
 
 deg = math.radians
 
@@ -58,3 +58,13 @@ def test_reward_rejects_non_finite_input():
 def test_termination_range():
     assert out_of_range(0.49) and out_of_range(5.01)
     assert not out_of_range(0.5) and not out_of_range(1.5) and not out_of_range(5.0)
+
+
+def test_array_reward_matches_the_scalar_one_everywhere():
+    import numpy as np
+
+    rng = np.random.default_rng(0)
+    d = np.concatenate([rng.uniform(0.0, 6.0, 2000), [0.5, 1.0, 1.5, 2.0, 5.0]])
+    a = np.concatenate([rng.uniform(-math.pi, math.pi, 2000), np.radians([0.0, 25.0, -25.0, 180.0, 90.0])])
+    expected = [follow_ahead_reward(x, y) for x, y in zip(d, a)]
+    assert np.allclose(follow_ahead_reward_array(d, a), expected)

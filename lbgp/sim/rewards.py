@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 MIN_DISTANCE = 0.5  # m: closer ends the episode
 MAX_DISTANCE = 5.0  # m: farther ends the episode
 CONE_DEG = 25.0  # half-angle of the rewarded cone in front of the person
@@ -43,3 +45,16 @@ def follow_ahead_reward(distance: float, alpha: float) -> float:
 def out_of_range(distance: float) -> bool:
     """The paper's termination: too close (D < 0.5 m) or too far (D > 5 m)."""
     return distance < MIN_DISTANCE or distance > MAX_DISTANCE
+
+
+def follow_ahead_reward_array(distance, alpha) -> np.ndarray:
+    """The same reward for arrays of D (m) and alpha (rad), elementwise (for analysis tools)."""
+    d = np.asarray(distance, dtype=float)
+    a = np.abs(np.degrees(np.asarray(alpha, dtype=float)))
+    r_d = np.select(
+        [(d < MIN_DISTANCE) | (d > MAX_DISTANCE), d < 1.0, d <= 2.0],
+        [-1.0, -(1.0 - d), 0.5 * (0.5 - np.abs(d - 1.5))],
+        -0.25 * (d - 1.0),
+    )
+    r_o = np.where(a < CONE_DEG, 0.5 * (CONE_DEG - a) / CONE_DEG, -0.25 * a / 180.0)
+    return np.clip(r_o + r_d, -1.0, 1.0)

@@ -57,10 +57,11 @@ def plot_learning_curves(run_dirs, out, labels=None) -> None:
     fig, ax = plt.subplots(figsize=(6, 4))
     for lab, ds in groups.items():
         curves = np.array([smoothed_curve(d, grid) for d in ds])
-        mean = np.nanmean(curves, axis=0)
-        half_std = 0.5 * np.nanstd(curves, axis=0)
-        ax.plot(grid, mean, label=f"{lab} ({len(ds)} run{'s' if len(ds) > 1 else ''})")
-        ax.fill_between(grid, mean - half_std, mean + half_std, alpha=0.25)
+        covered = np.isfinite(curves).any(axis=0)  # grid points some run of this group reached
+        mean = np.nanmean(curves[:, covered], axis=0)
+        half_std = 0.5 * np.nanstd(curves[:, covered], axis=0)
+        ax.plot(grid[covered], mean, label=f"{lab} ({len(ds)} run{'s' if len(ds) > 1 else ''})")
+        ax.fill_between(grid[covered], mean - half_std, mean + half_std, alpha=0.25)
     ax.set_xlabel("environment steps")
     ax.set_ylabel("exploit episode return (35 steps)")
     ax.set_title("Learning curves (shaded: half a standard deviation)")

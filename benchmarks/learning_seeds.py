@@ -20,17 +20,16 @@ ROOT = Path(__file__).resolve().parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT.parent / "tests"))
 from _common import write_result  # noqa: E402
-from test_learning import NetworkPolicy, RandomPolicy, straight_ahead_return  # noqa: E402
+from test_learning import NetworkPolicy, RandomPolicy, straight_ahead_return, straight_level_config  # noqa: E402
 
 from lbgp.agent import load_policy  # noqa: E402
-from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.networks import Actor  # noqa: E402
 from lbgp.agent.train import train  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 
 
 def one_seed(seed: int) -> dict:
-    cfg = D4PGConfig(seed=seed, total_steps=10_000, level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(10.0, 10.0, 10.0))
+    cfg = straight_level_config(seed=seed, total_steps=10_000)
     torch.manual_seed(seed)
     untrained = Actor(obs_lib.SIZE, 2, cfg.hidden)
     with tempfile.TemporaryDirectory() as tmp:

@@ -17,11 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+ROOT = Path(__file__).resolve().parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT.parent / "tests"))
 from _common import write_result  # noqa: E402
+from test_learning import straight_level_config  # noqa: E402
 
 from lbgp.agent import load_policy  # noqa: E402
-from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.train import train  # noqa: E402
 from lbgp.rollout import ConstantGoalPolicy, run_episode  # noqa: E402
 from lbgp.sim import make_env  # noqa: E402
@@ -38,8 +40,7 @@ def score(policy) -> dict:
 
 
 def one_weight(weight: float, steps: int, seed: int) -> dict:
-    cfg = D4PGConfig(seed=seed, total_steps=steps, prior_weight=weight,
-                     level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(10.0, 10.0, 10.0))
+    cfg = straight_level_config(seed=seed, total_steps=steps, prior_weight=weight)
     with tempfile.TemporaryDirectory() as tmp:
         train(cfg, Path(tmp) / "run", backend="inline", progress=False)
         return {"prior_weight": weight, **score(load_policy(Path(tmp) / "run" / "policy.pt"))}

@@ -40,7 +40,7 @@ from _common import write_result  # noqa: E402
 
 from lbgp.geometry import integrate_unicycle  # noqa: E402
 from lbgp.sim.rewards import MAX_DISTANCE, MIN_DISTANCE, follow_ahead_reward_array  # noqa: E402
-from lbgp.sim.tasks import CONTROL_PERIOD, DEFAULT_HORIZON, LEVELS  # noqa: E402
+from lbgp.sim.tasks import CONTROL_PERIOD, DEFAULT_HORIZON, LEVELS, SPAWN_DISTANCE  # noqa: E402
 
 EXTENT = 5.4  # m (1.5 m ahead is a grid point for h = 0.06, 0.046, 0.03): the grid covers [-EXTENT, EXTENT]^2
 # in the person frame (D > 5 ends an episode)
@@ -60,10 +60,7 @@ class StepModel:
     """One agent step of a person walking at (v, w): where each grid point lands, its reward and end."""
 
     def __init__(self, grid: Grid, v: float, w: float, dt: float):
-        if abs(w) < 1e-9:
-            dx, dy, turn = v * dt, 0.0, 0.0
-        else:
-            dx, dy, turn = v / w * math.sin(w * dt), v / w * (1.0 - math.cos(w * dt)), w * dt
+        dx, dy, turn = integrate_unicycle(np.zeros(3), v, w, dt)  # the person's move, in its old frame
         c, s = math.cos(turn), math.sin(turn)
         qx, qy = grid.x - dx, grid.y - dy
         px, py = c * qx + s * qy, -s * qx + c * qy  # where a point at q (after the robot's move) lands
@@ -105,7 +102,7 @@ def person_commands(setting_name: str, rng: np.random.Generator, steps: int = DE
 
 
 def start_points(n: int, rng: np.random.Generator):
-    distance = rng.uniform(1.0, 2.5, n)
+    distance = rng.uniform(*SPAWN_DISTANCE, n)
     alpha = rng.uniform(-math.pi, math.pi, n)
     return distance * np.cos(alpha), distance * np.sin(alpha), alpha
 
@@ -118,10 +115,11 @@ def level_ceiling(grid: Grid, level: str, vmax: float, starts: int = 4000, bins:
     rng = np.random.default_rng(0)
     x, y, alpha = start_points(starts, rng)
     steps = DEFAULT_HORIZON
+    model = LEVELS[level].motion()  # the level's own ranges of person speeds
     if level == "straight":
-        motions = [[(v, 0.0)] * steps for v in midpoints(0.3, 1.0, bins)]
+        motions = [[(v, 0.0)] * steps for v in midpoints(*model.speed_range, bins)]
     elif level == "circles":  # w < 0 is the mirror image of w > 0, same start distribution
-        motions = [[(v, w)] * steps for v in midpoints(0.2, 0.6, bins // 2 + 1) for w in midpoints(0.3, 0.8, bins // 2 + 1)]
+        motions = [[(v, w)] * steps for v in midpoints(*model.v_range, bins // 2 + 1) for w in midpoints(*model.w_range, bins // 2 + 1)]
     else:  # a sample of episodes of the level's own person motion
         motions = [person_commands(level, rng) for _ in range(episodes)]
     per_start = []

@@ -56,10 +56,16 @@ def straight_ahead_return(policy, episodes=2):
     return float(np.mean([run_episode(env, policy).total_reward for _ in range(episodes)]))
 
 
+def straight_level_config(seed: int, total_steps: int, **overrides) -> D4PGConfig:
+    """Training that stays on the first curriculum level: unreachable thresholds and a budget larger
+    than the run (also used by benchmarks/learning_seeds.py and benchmarks/prior_weight_sweep.py)."""
+    return D4PGConfig(seed=seed, total_steps=total_steps, level_thresholds=(1e9, 1e9, 1e9),
+                      level_budget_fraction=(10.0, 10.0, 10.0), **overrides)
+
+
 @pytest.mark.slow
 def test_short_training_on_the_straight_level_beats_random_and_untrained(tmp_path):
-    # stay on the first curriculum level: unreachable thresholds and a budget larger than the run
-    cfg = D4PGConfig(seed=0, total_steps=10_000, level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(10.0, 10.0, 10.0))
+    cfg = straight_level_config(seed=0, total_steps=10_000)
     torch.manual_seed(cfg.seed)
     untrained = Actor(obs_lib.SIZE, 2, cfg.hidden)  # the learner's initial actor (same seed, same construction)
     summary = train(cfg, tmp_path / "run", backend="inline", progress=False)

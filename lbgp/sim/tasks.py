@@ -29,6 +29,7 @@ from lbgp.world import WorldState
 
 CONTROL_PERIOD = 0.2  # s, one agent step = one observation frame
 DEFAULT_HORIZON = 35  # agent steps (the authors' configuration; the paper does not state it)
+SPAWN_DISTANCE = (1.0, 2.5)  # m: training levels start the robot this far from the person (paper)
 
 
 # ============================================================================ physics
@@ -243,7 +244,7 @@ class FollowAheadTask(control.Task):
         self.person_pose = self.motion.reset(self.rng, np.array([0.0, 0.0, yaw]))
         self._prev_person_pose = self.person_pose.copy()
         if self.setting.spawn is None:
-            distance = float(self.rng.uniform(1.0, 2.5))
+            distance = float(self.rng.uniform(*SPAWN_DISTANCE))
             alpha = float(self.rng.uniform(-math.pi, math.pi))
             robot = pose_from_polar(self.person_pose, distance, alpha)
             robot[2] = float(self.rng.uniform(-math.pi, math.pi))

@@ -65,3 +65,15 @@ def test_evaluate_writes_the_documented_json(tmp_path):
 def test_evaluate_rejects_unknown_scenarios(capsys):
     assert main(["evaluate", "--method", "scripted", "--scenario", "moonwalk"]) == 2
     assert "unknown scenario 'moonwalk'" in capsys.readouterr().err
+
+
+def test_train_prior_weight_option_reaches_the_run_config_and_bad_values_are_refused(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["train", "--prior-weight", "-1", "--out", str(run)]) == 2
+    assert "prior_weight must be >= 0" in capsys.readouterr().err
+    assert not run.exists()  # refused before anything is written
+    assert main(["train", "--prior-weight", "0.25", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    assert json.loads((run / "config.json").read_text())["prior_weight"] == 0.25
+    default = tmp_path / "default"
+    assert main(["train", "--steps", "40", "--backend", "inline", "--out", str(default)]) == 0
+    assert json.loads((default / "config.json").read_text())["prior_weight"] == 1.0

@@ -1,9 +1,7 @@
 """Planner parameters, one preset per robot.
 
-Starting point: the defaults published with the ROS ``teb_local_planner`` (weight_kinematics_nh
-1000, weight_kinematics_forward_drive 1, min_obstacle_dist as a hard margin), then tuned for these
-two robots and for a moving person (forward drive raised to 100 so that the band does not wiggle
-backwards near the goal):
+The weights are those of a least-squares tracking problem in SI units (see ``teb.py``); the
+safety margin plays the role of TEB's ``min_obstacle_dist``.
 TEB's stock speed limits (0.4 m/s, 0.3 rad/s) are far too slow to get in front of a walking person,
 so the limits below come from the robots' published top speeds, derated.
 """
@@ -29,32 +27,29 @@ class PlannerConfig:
     footprint_radius: float = 0.27  # m
     person_radius: float = PERSON_RADIUS
     safety_margin: float = 0.08  # m, clearance kept between footprint and person
-    dt_min: float = 0.01  # s, shortest time between two band poses
-    # objective weights (TEB names in brackets)
-    weight_goal: float = 20.0  # goal position error^2 of the last pose
-    weight_goal_heading: float = 0.5
-    weight_elastic: float = 1.0  # squared segment lengths: short, evenly spaced band
-    weight_nonholonomic: float = 1000.0  # (weight_kinematics_nh)
-    weight_turn: float = 1.0  # squared heading change per segment
-    weight_forward_drive: float = 100.0  # (weight_kinematics_forward_drive)
-    weight_clearance_slack: float = 1e3  # exact-penalty weight of a clearance violation (m)
+    band_dt: float = 0.1  # s between band poses (= the control period: the first segment is the command)
+    # objective weights (least squares; units m, rad, m/s, rad/s)
+    weight_track: float = 1.0  # every pose: squared distance from the moving goal at that pose's time
+    weight_goal: float = 4.0  # extra on the last pose's goal distance
+    weight_goal_heading: float = 0.5  # last pose's heading vs the goal's
+    weight_acc: float = 0.05  # squared change of v between segments (and from the current v)
+    weight_alpha: float = 0.02  # squared change of w between segments (and from the current w)
+    weight_turn: float = 0.01  # squared w
+    weight_clearance_slack: float = 10.0  # quadratic penalty of a clearance violation (m)
+    weight_clearance_l1: float = 100.0  # exact (L1) penalty of a clearance violation (m)
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
-    slowdown_factors: tuple = (0.7, 0.5, 0.3, 0.15)  # speed-limit scales tried when the person crosses the band
-    slowdown_horizon: float = 1.5  # s: only crossings this soon make the robot wait
-    regularization: float = 1e-2  # proximal term of each SQP step
+    regularization: float = 1e-4  # proximal (Levenberg-Marquardt) term of each SQP step
     # sequential QP
-    sqp_iterations: int = 2  # iterations when warm-started (the band also keeps improving from call
-    # to call, as in real-time-iteration MPC; 2 plans clearly better than 1 around a walking person)
-    sqp_iterations_init: int = 6  # iterations after a (re)initialisation
+    sqp_iterations: int = 8  # at most, per candidate band; stops earlier at step_tolerance
     sqp_time_budget: float | None = None  # s: anytime mode (deployment): no further SQP iteration once it would
-    # end past this budget (at least one always runs); None: the fixed counts above (simulation, reproducible)
-    trust_region_position: float = 0.4  # m per iteration
-    trust_region_heading: float = 0.8  # rad per iteration
-    step_tolerance: float = 1e-3  # stop early when the step is this small
-    reinit_goal_jump: float = 1.0  # m: a goal moving farther than this re-initialises the band
+    # end past this budget (at least one always runs); None: iterate to step_tolerance (simulation, reproducible)
+    trust_region_v: float = 0.75  # m/s change of each segment's v per iteration
+    trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
+    step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this
+    turn_around_candidate: bool = True  # also solve a band that turns to face a goal behind the robot
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)
-    osqp_max_iter: int = 200
-    osqp_eps: float = 1e-3
+    osqp_max_iter: int = 4000
+    osqp_eps: float = 1e-4  # absolute and relative tolerance of every QP, then polished (exact active set)
 
     @property
     def safety_distance(self) -> float:

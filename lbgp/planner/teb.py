@@ -1,48 +1,35 @@
-"""Timed-elastic-band local planner solved as a sequence of QPs with OSQP.
+"""Timed-band local planner solved as a sequence of QPs with OSQP: goal in, (v, w) out, the person
+as a moving obstacle.
 
-The band is N poses (x, y, theta) and the N-1 time intervals dt between them (TEB's formulation).
-One planner call runs a few sequential-QP iterations; each iteration
+The band is N poses timed at a fixed interval h (``band_dt``, the control period), so pose i is
+where the robot will be at t_i = i h. The band is parameterised by the M = N - 1 commands
+(v_k, w_k) between its poses (``lbgp.planner.kinematics``): diff-drive kinematics hold exactly,
+velocity limits are bounds and acceleration limits are linear constraints, both exact.
 
-1. times the band: the dt that make it as fast as the velocity and acceleration limits allow,
-   starting from the robot's current velocity and arriving with the goal velocity
-   (``lbgp.planner.timing``; TEB's minimal-total-time objective and its velocity/acceleration
-   edges, solved in closed form instead of inside the QP, which keeps the QP well conditioned);
-2. linearises the rest of TEB's objective and constraints around the current band, with the
-   person's position predicted (constant velocity) at each pose's time, and solves one QP for a step
-   ``d`` of the poses with OSQP, inside a trust region.
+Objective (least squares, SI units): every pose i tracks the goal's *predicted* position at its
+own time, g(t_i) = goal + goal_velocity * t_i (a goal carried by a walking person is a moving
+target: a goal slightly behind the robot is met by slowing down, never by looping back to where
+it was), with extra weight on the last pose and on its heading; small costs on changes of v and w
+(smooth commands) and on w. Constraints: velocity and acceleration limits (the first segment from
+the robot's current velocity over one control period), a trust region per SQP iteration, and a
+clearance of at least the safety distance from the person's predicted position (constant
+velocity) at every pose's time, linearised as half-planes, elastic (slack with an exact L1 plus a
+quadratic penalty) so that the QP is always feasible.
 
-The QP's sparsity is fixed at construction: OSQP is set up once, and every later solve only
-``update``s values and warm-starts.
+Sequential QP (Gauss-Newton): each iteration rolls the commands out, linearises, and solves one QP
+for the command step with OSQP, to a stated accuracy (``osqp_eps``, then polished); iterations
+stop when no command moves more than ``step_tolerance``. The QP's sparsity is fixed: OSQP is set
+up once, every later solve only updates values.
 
-Variable layout of one QP (N = n_poses; all entries are steps from the current band):
+No hidden state: every call starts from the same deterministic first guess (a pursuit of the
+moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
+and velocity, person pose and velocity, goal) alone; OSQP's warm start only saves iterations.
+Local minima (TEB's remedy: several bands in distinct topologies): when the goal lies behind the
+robot, a second band that turns the robot around is solved too, and the cheaper one is kept.
 
-    d = [ dx_0 .. dx_{N-1} | dy_0 .. dy_{N-1} | dtheta_0 .. dtheta_{N-1} | s_1 .. s_{N-1} ]
-          0 .. N-1           N .. 2N-1          2N .. 3N-1                  3N .. 4N-2
-
-where s_i >= 0 is the slack of pose i's clearance constraint (elastic mode: the QP stays feasible
-when one step cannot clear the person; slack costs an exact L1 penalty plus a quadratic one).
-
-Objective (soft, Gauss-Newton on squared residuals): goal position and heading of the last pose;
-elastic band (squared segment lengths: short, evenly spaced band, i.e. short travel time);
-non-holonomic kinematics (TEB's residual: each segment along the mean of its end headings);
-squared heading changes (turning takes time);
-forward-drive preference (backward segments penalised); a small proximal term.
-Constraints (linearised): first pose fixed at the robot; trust region; at every later pose a
-distance of at least the safety distance from the person's predicted position, as a half-plane
-through the linearisation point (elastic, see the slacks above). If after the step the next pose
-(the one the command drives to) is inside the safety distance and closer to the person than the
-robot is now, the call returns a safe stop with status ``infeasible``: the robot never drives
-deeper into the person's safety radius (moving out of it, e.g. away from a person who walks
-towards the robot, is allowed).
-
-If the person's predicted path crosses the band within the next ``slowdown_horizon`` seconds at
-its time-optimal timing, the band is re-timed slower (``slowdown_factors`` of the speed limits)
-until it clears: the robot waits for the person to pass rather than racing them.
-
-The command is the first segment's (v, w), clamped to the velocity limits and to the acceleration
-limits over one control period, so the hard limits hold even when the band is only approximately
-feasible. Failures (bad input, goal inside the person's safety radius, infeasible QP, solver error,
-diverging band) return a safe stop (decelerate within limits) with a status that says why.
+A goal within the person's safety distance, bad input, a failed QP, or a next pose that would go
+deeper into the person's safety radius returns a safe stop (decelerate within limits) with a
+status that says why.
 """
 
 from __future__ import annotations
@@ -56,9 +43,8 @@ import osqp
 import scipy.sparse as sp
 
 from lbgp.geometry import wrap_angle
-from lbgp.planner.band import Band, band_is_sane, initial_band, shifted_band
 from lbgp.planner.config import PlannerConfig
-from lbgp.planner.timing import time_segments
+from lbgp.planner.kinematics import position_jacobian, pursuit_commands, rollout
 
 OK = "ok"
 INVALID_INPUT = "invalid_input"
@@ -67,7 +53,7 @@ INFEASIBLE = "infeasible"
 SOLVER_ERROR = "solver_error"
 DIVERGED = "diverged"
 
-_SOLVED = {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE, osqp.SolverStatus.OSQP_MAX_ITER_REACHED}
+_SOLVED = {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE}
 _INFEASIBLE = {osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE, osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE}
 
 
@@ -81,8 +67,9 @@ class Plan:
     poses: np.ndarray  # (N, 3) band poses, world frame (empty on invalid input)
     times: np.ndarray  # (N,) time of each pose from now, s
     person_prediction: np.ndarray  # (N, 2) predicted person positions at those times
-    iterations: int = 0
+    iterations: int = 0  # SQP iterations, all candidate bands together
     solve_time: float = 0.0  # s, wall time of this call
+    candidate: str = ""  # which first guess the kept band came from ("keep" or "turn")
 
     @property
     def ok(self) -> bool:
@@ -110,44 +97,46 @@ def safe_stop(v_now: float, w_now: float, cfg: PlannerConfig) -> tuple[float, fl
     return clamp_command(v, w, v_now, w_now, cfg)
 
 
+@dataclasses.dataclass
+class _Problem:
+    """Everything one call's QPs share (world frame)."""
+
+    pose0: np.ndarray
+    v_ref: float
+    w_ref: float
+    goal_path: np.ndarray  # (M, 2) goal position at each pose's time
+    goal_yaw: float
+    person_path: np.ndarray  # (N, 2) predicted person position at each pose's time, from now
+
+
 class TebPlanner:
-    """Plan a band from the robot to a goal around a moving person; see the module docstring."""
+    """Plan a timed band from the robot to a moving goal around a moving person; see the module
+    docstring. ``stats`` counts OSQP solves, iterations and how often the iteration cap was hit."""
 
     def __init__(self, config: PlannerConfig | None = None):
         self.cfg = config or PlannerConfig()
         N = self.cfg.n_poses
         if N < 3:
             raise ValueError(f"n_poses must be at least 3, got {N}")
-        self.N = N
-        self.nvar = 3 * N + (N - 1)  # poses, then one clearance slack per pose 1..N-1
-        self.islack = 3 * N + np.arange(N - 1)
-        self.ix, self.iy, self.ith = np.arange(N), N + np.arange(N), 2 * N + np.arange(N)
-        self._k = np.arange(N - 1)
-        self._band: Band | None = None
-        self._goal: np.ndarray | None = None
+        self.N, self.M = N, N - 1
+        self.h = float(self.cfg.band_dt)
         self._solver = None
+        self.stats = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "inaccurate": 0}
         self._setup_structure()
 
     # ------------------------------------------------------------------ public
     def reset(self) -> None:
-        """Forget the previous band (the next call re-initialises) and OSQP's state (warm start,
-        adapted step size), so that an episode's plans do not depend on the episodes before it."""
-        self._forget_band()
+        """Drop OSQP's warm start (plans never depended on it beyond the solver's tolerance)."""
         self._solver = None
-
-    def _forget_band(self) -> None:
-        self._band = None
-        self._goal = None
 
     def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0)) -> Plan:
         """One planner call.
 
         ``goal`` is (x, y) or (x, y, yaw) in the world now; its yaw defaults to the person's
         heading. ``person_velocity`` is the person's world (vx, vy). ``goal_velocity`` is the goal's
-        world (vx, vy): a goal carried along by a walking person moves with it, so the band ends
-        where the goal will be when the robot gets there and arrives with the goal's speed
-        ((0, 0): a fixed goal, stop there). Never raises on bad numbers: returns a safe-stop plan
-        whose status says why.
+        world (vx, vy): a goal carried along by a walking person moves with it, and every band pose
+        tracks where the goal will be at that pose's time ((0, 0): a fixed goal, stop there).
+        Never raises on bad numbers: returns a safe-stop plan whose status says why.
         """
         t_start = time.perf_counter()
         cfg = self.cfg
@@ -167,235 +156,237 @@ class TebPlanner:
         if not np.all(np.isfinite(values)):
             return self._stop(v_now, w_now, INVALID_INPUT, t_start)
         if np.linalg.norm(goal[:2] - person_pose[:2]) < cfg.safety_distance:
-            self._forget_band()
             return self._stop(v_now, w_now, GOAL_IN_COLLISION, t_start)
 
-        warm = self._band is not None and np.linalg.norm(goal[:2] - self._goal[:2]) <= cfg.reinit_goal_jump
-        goal_speed = float(np.hypot(*goal_vel))
-        if warm:
-            band = shifted_band(self._band, robot_pose, cfg.dt_min)
-        else:
-            # aim the first band where the goal will be after a rough travel-time estimate
-            closing = max(cfg.max_vel_x - goal_speed, 0.2 * cfg.max_vel_x)
-            eta = min(np.linalg.norm(goal[:2] - robot_pose[:2]) / closing, 5.0)
-            ahead = np.r_[goal[:2] + goal_vel * eta, goal[2]]
-            band = initial_band(robot_pose, ahead, person_pose[:2], cfg.safety_distance + 0.1, self.N)
-        iterations = cfg.sqp_iterations if warm else cfg.sqp_iterations_init
-        scale = float(np.linalg.norm(goal[:2] - robot_pose[:2])) + 1.0
-        status, done = OK, 0
-        t_loop = time.perf_counter()
-        for done in range(1, iterations + 1):
-            if cfg.sqp_time_budget is not None and done > 1:
-                spent = time.perf_counter() - t_start
-                if spent + (time.perf_counter() - t_loop) / (done - 1) > cfg.sqp_time_budget:
-                    done -= 1
-                    break  # anytime: the band keeps improving from the next call (warm start)
-            band.dt = self._timing(band, v_now, w_now, goal_speed)
-            goal_then = np.r_[goal[:2] + goal_vel * band.times[-1], goal[2]]
-            step, status = self._sqp_step(band, goal_then, person_pose[:2], person_vel)
+        times = self._times[1:]
+        problem = _Problem(
+            pose0=robot_pose,
+            v_ref=min(max(v_now, -cfg.max_vel_x_backwards), cfg.max_vel_x),
+            w_ref=min(max(w_now, -cfg.max_vel_theta), cfg.max_vel_theta),
+            goal_path=goal[None, :2] + times[:, None] * goal_vel[None, :],
+            goal_yaw=float(goal[2]),
+            person_path=person_pose[None, :2] + self._times[:, None] * person_vel[None, :],
+        )
+        candidates = ["keep"]
+        if cfg.turn_around_candidate and self._goal_behind(problem):
+            candidates.append("turn")
+        best, iterations = None, 0
+        for name in candidates:
+            if name != "keep" and self._over_budget(t_start, iterations):
+                break
+            v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, goal[:2], goal_vel, self.h,
+                                      cfg.control_period, self.M, cfg, reverse=(name == "keep"))
+            u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations)
+            iterations += done
             if status != OK:
-                break
-            step[[self.ix[0], self.iy[0], self.ith[0]]] = 0.0  # exact, not just to OSQP's tolerance
-            band.poses[:, 0] += step[self.ix]
-            band.poses[:, 1] += step[self.iy]
-            band.poses[:, 2] += step[self.ith]
-            if not band_is_sane(band, scale):
-                status = DIVERGED
-                break
-            if float(np.max(np.abs(step))) < cfg.step_tolerance:
-                break
-        if status != OK:
-            self._forget_band()
-            return self._stop(v_now, w_now, status, t_start, band, person_pose[:2], person_vel, done)
-        band.dt = self._timing(band, v_now, w_now, goal_speed)
-        clear_soon, clearance = self._clear_soon(band, person_pose[:2], person_vel)
-        if not clear_soon:
-            # the person would cross the band soon while we drive it: wait for them, drive it slower
-            for slower in cfg.slowdown_factors:
-                timed = Band(band.poses, self._timing(band, v_now, w_now, goal_speed, speed_scale=slower))
-                clear_soon, c = self._clear_soon(timed, person_pose[:2], person_vel)
-                if clear_soon:
-                    band.dt, clearance = timed.dt, c
-                    break
-        if clearance[1] < cfg.safety_distance - cfg.clearance_tolerance and clearance[1] < clearance[0]:
-            self._forget_band()
-            return self._stop(v_now, w_now, INFEASIBLE, t_start, band, person_pose[:2], person_vel, done)
-        self._band, self._goal = band.copy(), goal.copy()
-
-        d = band.poses[1] - band.poses[0]
-        heading = band.poses[0, 2]
-        v = (math.cos(heading) * d[0] + math.sin(heading) * d[1]) / band.dt[0]
-        w = d[2] / band.dt[0]
-        v, w = clamp_command(v, w, v_now, w_now, cfg)
-        return self._result(v, w, OK, band, person_pose[:2], person_vel, done, t_start)
+                return self._stop(v_now, w_now, status, t_start, None, problem, iterations)
+            cost = self._cost(problem, u)
+            if best is None or cost < best[0] - 1e-9:
+                best = (cost, u, name)
+        _, u, name = best
+        poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
+        clearance = np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T)
+        now = float(np.hypot(*(robot_pose[:2] - person_pose[:2])))
+        if clearance[0] < cfg.safety_distance - cfg.clearance_tolerance and clearance[0] < now:
+            return self._stop(v_now, w_now, INFEASIBLE, t_start, poses, problem, iterations)
+        v, w = clamp_command(float(u[0]), float(u[self.M]), v_now, w_now, cfg)
+        return self._result(v, w, OK, poses, problem, iterations, t_start, name)
 
     # ------------------------------------------------------------------ helpers
-    def _timing(self, band: Band, v_now, w_now, goal_speed, speed_scale: float = 1.0) -> np.ndarray:
-        cfg = self.cfg
-        poses = band.poses
-        d = poses[1:] - poses[:-1]
-        mid = poses[:-1, 2] + 0.5 * d[:, 2]
-        length = np.cos(mid) * d[:, 0] + np.sin(mid) * d[:, 1]
-        return time_segments(
-            length, d[:, 2], v_now, w_now, goal_speed,
-            cfg.max_vel_x * speed_scale, cfg.max_vel_x_backwards * speed_scale, cfg.max_vel_theta,
-            cfg.acc_lim_x, cfg.acc_lim_theta, cfg.dt_min,
-        )
+    def _goal_behind(self, problem: _Problem) -> bool:
+        """Whether the goal, half way through the band's horizon, lies behind the robot."""
+        x, y, th = problem.pose0
+        g = problem.goal_path[self.M // 2]
+        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < 0.0
 
-    def _result(self, v, w, status, band, person_xy, person_vel, iterations, t_start) -> Plan:
-        times = band.times
-        prediction = person_xy[None, :] + times[:, None] * person_vel[None, :]
-        poses = band.poses.copy()
+    def _over_budget(self, t_start: float, iterations: int) -> bool:
+        budget = self.cfg.sqp_time_budget
+        if budget is None or iterations == 0:
+            return False
+        spent = time.perf_counter() - t_start
+        return spent + spent / iterations > budget
+
+    def _result(self, v, w, status, poses, problem, iterations, t_start, candidate="") -> Plan:
+        poses = poses.copy()
         poses[:, 2] = wrap_angle(poses[:, 2])
-        return Plan(v, w, status, poses, times, prediction, iterations, time.perf_counter() - t_start)
+        return Plan(v, w, status, poses, self._times.copy(), problem.person_path.copy(), iterations, time.perf_counter() - t_start, candidate)
 
-    def _stop(self, v_now, w_now, status, t_start, band=None, person_xy=None, person_vel=None, iterations=0) -> Plan:
+    def _stop(self, v_now, w_now, status, t_start, poses=None, problem=None, iterations=0) -> Plan:
         v, w = safe_stop(v_now, w_now, self.cfg)
-        if band is None or not band_is_sane(band, 1e6):
+        if poses is None or problem is None or not np.all(np.isfinite(poses)):
             return Plan(v, w, status, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 2)), iterations, time.perf_counter() - t_start)
-        return self._result(v, w, status, band, person_xy, person_vel, iterations, t_start)
+        return self._result(v, w, status, poses, problem, iterations, t_start)
 
     # ------------------------------------------------------------------ the QP
-    # Soft residual rows, in order: goal (x, y, heading) | elastic dx_i | elastic dy_i |
-    # non-holonomic_i | turn_i | forward-drive_i  (i = 0 .. N-2). The Jacobian J of these residuals
-    # has fixed entries (goal, elastic, turn: +-1) written once, and entries that change with the
-    # band (non-holonomic, forward drive) written at fixed flat positions every iteration.
+    # Multiple shooting: the QP's variables are the steps of the poses AND of the commands, tied by
+    # the linearised kinematics as equality rows, which keeps the QP sparse and well conditioned
+    # (condensed to commands only, the Hessian's condition number grows like M^4 and OSQP needs
+    # ~1,000 iterations). After each QP only the command step is kept and the poses are rolled out
+    # again, so the band always satisfies the kinematics exactly.
+    # Variables: [dx_1..dx_M | dy_1..dy_M | dth_1..dth_M | dv_0..dv_{M-1} | dw_0..dw_{M-1} | s_1..s_M]
+    # Rows: [0, 3M) kinematics (= 0) | [3M, 5M) command bounds and trust region | [5M, 6M) s >= 0 |
+    # [6M, 7M) v changes (acceleration) | [7M, 8M) w changes | [8M, 9M) clearance of pose 1..M.
 
     def _setup_structure(self) -> None:
-        """Weights, constant Jacobian entries, the constant part of the constraints, and the fixed
-        sparsity of P and A (from a generic random band with every hinge active)."""
-        cfg, N, n = self.cfg, self.N, self.nvar
-        ix, iy, ith, k = self.ix, self.iy, self.ith, self._k
-        self._n_res = 3 + 5 * (N - 1)
-        self._weights = np.concatenate([
-            [cfg.weight_goal, cfg.weight_goal, cfg.weight_goal_heading],
-            np.full(2 * (N - 1), cfg.weight_elastic),
-            np.full(N - 1, cfg.weight_nonholonomic),
-            np.full(N - 1, cfg.weight_turn),
-            np.full(N - 1, cfg.weight_forward_drive),
-        ])
-        J = np.zeros((self._n_res, n))
-        J[0, ix[-1]] = J[1, iy[-1]] = J[2, ith[-1]] = 1.0
-        row_dx, row_dy, row_nh, row_turn, row_fwd = (3 + j * (N - 1) + k for j in range(5))
-        for rows, idx in ((row_dx, ix), (row_dy, iy), (row_turn, ith)):
-            J[rows, idx[:-1]] = -1.0
-            J[rows, idx[1:]] = 1.0
-        self._J = J
-        flat = lambda rows, cols: rows * n + cols  # noqa: E731
-        self._J_dynamic = np.concatenate([
-            flat(row_nh, ix[:-1]), flat(row_nh, ix[1:]), flat(row_nh, iy[:-1]), flat(row_nh, iy[1:]),
-            flat(row_nh, ith[:-1]), flat(row_nh, ith[1:]),
-            flat(row_fwd, ix[:-1]), flat(row_fwd, ix[1:]), flat(row_fwd, iy[:-1]), flat(row_fwd, iy[1:]),
-        ])
-        # constraints: rows 0..n-1 trust region (first pose fixed); rows n.. person clearance
-        self._m = n + (N - 1)
-        self._diag = np.diag_indices(n)
-        self._A = np.zeros((self._m, n))
-        self._A[self._diag] = 1.0
-        self._A[n + k, self.islack] = 1.0
-        self._A_dynamic = np.concatenate([flat(n + k, ix[1:]), flat(n + k, iy[1:])])
-        trust = np.concatenate([np.full(2 * N, cfg.trust_region_position), np.full(N, cfg.trust_region_heading)])
-        trust[[ix[0], iy[0], ith[0]]] = 0.0
-        self._lo = np.concatenate([-trust, np.zeros(N - 1), np.zeros(N - 1)])
-        self._hi = np.concatenate([trust, np.full(N - 1, np.inf), np.full(N - 1, np.inf)])
-        self._slack_q = np.zeros(n)
-        self._slack_q[self.islack] = cfg.weight_clearance_slack
-        rng = np.random.default_rng(0)
-        band = Band(rng.normal(size=(N, 3)), rng.uniform(0.1, 0.5, N - 1))
-        P, _, A, _, _ = self._assemble(band, rng.normal(size=3), rng.normal(size=2), rng.normal(size=2), pattern=True)
-        P_pat = sp.csc_matrix(np.triu(P) != 0)
-        A_pat = sp.csc_matrix(A != 0)
+        cfg, M, h = self.cfg, self.M, self.h
+        self.n, self.m = 6 * M, 9 * M
+        n, m = self.n, self.m
+        X, Y, TH, V, W, S = (j * M for j in range(6))
+        k = np.arange(M)
+        self._times = h * np.arange(self.N)
+        track = np.full(M, cfg.weight_track)
+        track[-1] += cfg.weight_goal
+        self._w_track = np.concatenate([track, track])
+        # constant residual rows on the commands: v changes, w changes, w (and the last heading,
+        # which is a pose variable here)
+        diff = np.eye(M) - np.eye(M, k=-1)
+        Jc = np.zeros((3 * M, 2 * M))
+        Jc[:M, :M] = diff
+        Jc[M : 2 * M, M:] = diff
+        Jc[2 * M :, M:] = np.eye(M)
+        self._Jc = Jc
+        self._w_const = np.concatenate([np.full(M, cfg.weight_acc), np.full(M, cfg.weight_alpha), np.full(M, cfg.weight_turn)])
+        P = np.zeros((n, n))
+        P[X : X + M, X : X + M] = np.diag(2.0 * track)
+        P[Y : Y + M, Y : Y + M] = np.diag(2.0 * track)
+        P[TH + M - 1, TH + M - 1] = 2.0 * cfg.weight_goal_heading
+        P[V : W + M, V : W + M] = 2.0 * Jc.T @ (self._w_const[:, None] * Jc)
+        P[np.arange(S), np.arange(S)] += 2.0 * cfg.regularization
+        P[S:, S:] += 2.0 * cfg.weight_clearance_slack * np.eye(M)
+        # constraints; the kinematics rows' entries that depend on the band are listed in _kin_at
+        A = np.zeros((m, n))
+        A[X + k, X + k] = A[M + k, Y + k] = A[2 * M + k, TH + k] = 1.0  # pose k+1
+        A[X + k[1:], X + k[:-1]] = A[M + k[1:], Y + k[:-1]] = A[2 * M + k[1:], TH + k[:-1]] = -1.0  # pose k
+        A[2 * M + k, W + k] = -h
+        rows_x, rows_y = X + k, M + k
+        self._kin_at = (
+            np.concatenate([rows_x, rows_x, rows_y, rows_y, rows_x[1:], rows_y[1:]]),
+            np.concatenate([V + k, W + k, V + k, W + k, TH + k[:-1], TH + k[:-1]]),
+        )
+        A[3 * M + np.arange(2 * M), V + np.arange(2 * M)] = 1.0
+        A[5 * M + k, S + k] = 1.0
+        A[6 * M : 7 * M, V : V + M] = diff
+        A[7 * M : 8 * M, W : W + M] = diff
+        A[8 * M + k, S + k] = 1.0
+        self._clear_at = (np.concatenate([8 * M + k, 8 * M + k]), np.concatenate([X + k, Y + k]))
+        A[self._kin_at] = 1.0  # pattern only
+        A[self._clear_at] = 1.0
+        self._A = A
+        P_pat, A_pat = sp.csc_matrix(np.triu(P) != 0), sp.csc_matrix(A != 0)
         self._P_struct = (P_pat.indices.copy(), P_pat.indptr.copy())
         self._A_struct = (A_pat.indices.copy(), A_pat.indptr.copy())
-        self._P_at = (P_pat.indices.copy(), np.repeat(np.arange(n), np.diff(P_pat.indptr)))
+        P_at = (P_pat.indices.copy(), np.repeat(np.arange(n), np.diff(P_pat.indptr)))
         self._A_at = (A_pat.indices.copy(), np.repeat(np.arange(n), np.diff(A_pat.indptr)))
+        self._Px = np.triu(P)[P_at]
+        self._q = np.zeros(n)
+        self._q[S:] = cfg.weight_clearance_l1
+        self._lo = np.zeros(m)
+        self._hi = np.zeros(m)
+        self._hi[5 * M : 6 * M] = np.inf
+        self._hi[8 * M :] = np.inf
+        self._u_lo = np.concatenate([np.full(M, -cfg.max_vel_x_backwards), np.full(M, -cfg.max_vel_theta)])
+        self._u_hi = np.concatenate([np.full(M, cfg.max_vel_x), np.full(M, cfg.max_vel_theta)])
+        self._trust = np.concatenate([np.full(M, cfg.trust_region_v), np.full(M, cfg.trust_region_w)])
+        self._acc_v = np.full(M, cfg.acc_lim_x * h)
+        self._acc_v[0] = cfg.acc_lim_x * cfg.control_period
+        self._acc_w = np.full(M, cfg.acc_lim_theta * h)
+        self._acc_w[0] = cfg.acc_lim_theta * cfg.control_period
 
-    def _assemble(self, band: Band, goal, person_xy, person_vel, pattern: bool = False):
-        """Dense P, q, A, l, u of the QP for the step d around ``band`` (module docstring).
-        With ``pattern`` every hinge counts as active, so that P shows every possible non-zero."""
-        cfg, N = self.cfg, self.N
-        poses = band.poses
-        X, Y, TH = poses[:, 0], poses[:, 1], poses[:, 2]
-        d = poses[1:] - poses[:-1]
-        dX, dY, dTH = d[:, 0], d[:, 1], d[:, 2]
-        c, s = np.cos(TH), np.sin(TH)
-        cs, ss = c[:-1] + c[1:], s[:-1] + s[1:]
-        mid = TH[:-1] + 0.5 * dTH
-        cm, sm = np.cos(mid), np.sin(mid)
-        ds = cm * dX + sm * dY
-        fwd = np.ones(N - 1) if pattern else (ds < 0.0).astype(float)
-        # residuals, in the row order above
-        r = np.concatenate([
-            [X[-1] - goal[0], Y[-1] - goal[1], wrap_angle(TH[-1] - goal[2])],
-            dX, dY, cs * dY - ss * dX, dTH, ds * fwd,
-        ])
-        # Jacobian entries that change: non-holonomic (TEB) and forward-drive hinge
-        J = self._J
-        cmf, smf = cm * fwd, sm * fwd
-        J.flat[self._J_dynamic] = np.concatenate([
-            ss, -ss, -cs, cs, -s[:-1] * dY - c[:-1] * dX, -s[1:] * dY - c[1:] * dX,
-            -cmf, cmf, -smf, smf,
-        ])
-        JW = J * self._weights[:, None]
-        P = 2.0 * (J.T @ JW)
-        P[self._diag] += cfg.regularization
-        P[self.islack, self.islack] += 2.0 * cfg.weight_clearance_slack
-        q = 2.0 * (JW.T @ r) + self._slack_q
-        # person clearance at poses 1..N-1: n_i . (p_i - q_i) >= d_safe, q_i predicted at t_i
-        t = np.cumsum(band.dt)
-        diff = poses[1:, :2] - person_xy - t[:, None] * person_vel
-        dist = np.sqrt(np.einsum("ij,ij->i", diff, diff))
-        normal = diff / np.maximum(dist, 1e-9)[:, None]
-        A = self._A
-        A.flat[self._A_dynamic] = normal.T.ravel()
-        lo = self._lo
-        lo[self.nvar :] = cfg.safety_distance - dist
-        return P, q, A, lo, self._hi
+    def _residuals(self, problem: _Problem, u: np.ndarray, poses: np.ndarray):
+        """Tracking residuals (2M,), the last heading's error, and the command residuals (3M,)."""
+        M = self.M
+        track = (poses[1:, :2] - problem.goal_path).T.ravel()
+        v, w = u[:M], u[M:]
+        heading = wrap_angle(float(poses[-1, 2]) - problem.goal_yaw)
+        return track, heading, np.concatenate([np.diff(v, prepend=problem.v_ref), np.diff(w, prepend=problem.w_ref), w])
 
-    def _clear_soon(self, band: Band, person_xy, person_vel) -> tuple[bool, np.ndarray]:
-        """Whether the poses within ``slowdown_horizon`` (after the first) keep the safety distance
-        from the predicted person; also returns every pose's clearance."""
+    def _cost(self, problem: _Problem, u: np.ndarray) -> float:
+        """The objective at the commands ``u`` (nonlinear, with the clearance penalty)."""
         cfg = self.cfg
-        clearance = self._clearance(band, person_xy, person_vel)
-        near = band.times <= cfg.slowdown_horizon
-        near[0] = False
-        return bool(not near.any() or clearance[near].min() >= cfg.safety_distance - cfg.clearance_tolerance), clearance
+        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
+        track, heading, const = self._residuals(problem, u, poses)
+        violation = np.maximum(cfg.safety_distance - np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T), 0.0)
+        return float(self._w_track @ track**2 + cfg.weight_goal_heading * heading**2 + self._w_const @ const**2
+                     + cfg.weight_clearance_slack * violation @ violation + cfg.weight_clearance_l1 * violation.sum())
 
-    def _clearance(self, band: Band, person_xy, person_vel) -> np.ndarray:
-        """Distance of each band pose from the person's predicted position at that pose's time."""
-        diff = band.poses[:, :2] - person_xy - band.times[:, None] * person_vel
-        return np.sqrt(np.einsum("ij,ij->i", diff, diff))
+    def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int):
+        """SQP from the commands ``u``; returns (u, status, iterations)."""
+        cfg, M = self.cfg, self.M
+        u = np.clip(u, self._u_lo, self._u_hi)
+        done = 0
+        for done in range(1, cfg.sqp_iterations + 1):
+            if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
+                done -= 1
+                break
+            step, status = self._sqp_step(problem, u)
+            if status != OK:
+                return u, status, done
+            u = np.clip(u + step, self._u_lo, self._u_hi)
+            if not np.all(np.isfinite(u)):
+                return u, DIVERGED, done
+            if float(np.max(np.abs(step))) < cfg.step_tolerance:
+                break
+        return u, OK, done
 
-    def _sqp_step(self, band: Band, goal, person_xy, person_vel):
-        """Solve one QP around ``band``; returns (step, status)."""
-        P, q, A, lo, hi = self._assemble(band, goal, person_xy, person_vel)
-        Px, Ax = P[self._P_at], A[self._A_at]
-        if not (np.all(np.isfinite(Px)) and np.all(np.isfinite(Ax)) and np.all(np.isfinite(q)) and np.all(np.isfinite(lo))):
+    def _sqp_step(self, problem: _Problem, u: np.ndarray):
+        cfg, M, h = self.cfg, self.M, self.h
+        v, w = u[:M], u[M:]
+        poses = rollout(problem.pose0, v, w, h)
+        phi = poses[:-1, 2] + 0.5 * h * w
+        c, s = np.cos(phi), np.sin(phi)
+        hv = h * v
+        A = self._A
+        # d/d(v_k, w_k) and d/d(theta_k) of x_{k+1} - x_k - h v_k cos(phi_k) (and y), k >= 1 for theta
+        A[self._kin_at] = np.concatenate([
+            -h * c, 0.5 * h * hv * s, -h * s, -0.5 * h * hv * c, hv[1:] * s[1:], -hv[1:] * c[1:],
+        ])
+        diff = poses[1:, :2] - problem.person_path[1:]
+        dist = np.hypot(diff[:, 0], diff[:, 1])
+        normal = diff / np.maximum(dist, 1e-9)[:, None]
+        A[self._clear_at] = normal.T.ravel()
+        q = self._q
+        track, heading, const = self._residuals(problem, u, poses)
+        q[: 2 * M] = 2.0 * self._w_track * track
+        q[2 * M : 3 * M] = 0.0
+        q[3 * M - 1] = 2.0 * cfg.weight_goal_heading * heading
+        q[3 * M : 5 * M] = 2.0 * self._Jc.T @ (self._w_const * const)
+        lo, hi = self._lo, self._hi
+        lo[3 * M : 5 * M] = np.maximum(self._u_lo - u, -self._trust)
+        hi[3 * M : 5 * M] = np.maximum(np.minimum(self._u_hi - u, self._trust), lo[3 * M : 5 * M])
+        dv = np.diff(v, prepend=problem.v_ref)
+        dw = np.diff(w, prepend=problem.w_ref)
+        lo[6 * M : 7 * M], hi[6 * M : 7 * M] = -self._acc_v - dv, self._acc_v - dv
+        lo[7 * M : 8 * M], hi[7 * M : 8 * M] = -self._acc_w - dw, self._acc_w - dw
+        # the current commands satisfy the limits up to rounding: never ask for less than nothing
+        hi[6 * M : 8 * M] = np.maximum(hi[6 * M : 8 * M], lo[6 * M : 8 * M])
+        lo[8 * M :] = cfg.safety_distance - dist
+        Ax = A[self._A_at]
+        if not (np.all(np.isfinite(Ax)) and np.all(np.isfinite(q)) and np.all(np.isfinite(lo))):
             return None, DIVERGED
         if self._solver is None:
             self._solver = osqp.OSQP()
             self._solver.setup(
-                sp.csc_matrix((Px, *self._P_struct), shape=(self.nvar, self.nvar)),
-                q,
-                sp.csc_matrix((Ax, *self._A_struct), shape=(self._m, self.nvar)),
-                lo,
-                hi,
-                verbose=False,
-                polishing=False,
-                warm_starting=True,
-                eps_abs=self.cfg.osqp_eps,
-                eps_rel=self.cfg.osqp_eps,
-                max_iter=self.cfg.osqp_max_iter,
+                sp.csc_matrix((self._Px, *self._P_struct), shape=(self.n, self.n)), q,
+                sp.csc_matrix((Ax, *self._A_struct), shape=(self.m, self.n)), lo, hi,
+                verbose=False, polishing=True, warm_starting=True,
+                eps_abs=cfg.osqp_eps, eps_rel=cfg.osqp_eps, max_iter=cfg.osqp_max_iter,
             )
         else:
-            self._solver.update(Px=Px, Ax=Ax, q=q, l=lo, u=hi)
+            self._solver.update(Ax=Ax, q=q, l=lo, u=hi)
         result = self._solver.solve(raise_error=False)
-        status = result.info.status_val
+        info = result.info
+        self.stats["solves"] += 1
+        self.stats["osqp_iterations"] += int(info.iter)
+        status = info.status_val
+        if status == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
+            self.stats["max_iter_hits"] += 1
+        if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
+            self.stats["inaccurate"] += 1
         if status in _INFEASIBLE:
             return None, INFEASIBLE
         if status not in _SOLVED:
             return None, SOLVER_ERROR
-        step = np.asarray(result.x, dtype=float)
+        step = np.asarray(result.x[3 * M : 5 * M], dtype=float)
         if not np.all(np.isfinite(step)):
             return None, SOLVER_ERROR
         return step, OK

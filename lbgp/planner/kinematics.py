@@ -1,0 +1,95 @@
+"""The band's poses as a function of the commands between them (diff-drive kinematics, exact).
+
+A band of N poses is timed at a fixed interval h; between pose k and k+1 the robot drives (v_k, w_k)
+for h seconds. Each segment is integrated with the midpoint heading,
+
+    theta_{k+1} = theta_k + w_k h
+    p_{k+1}     = p_k + v_k h (cos phi_k, sin phi_k),   phi_k = theta_k + w_k h / 2,
+
+so the band is non-holonomic by construction, and its Jacobian has a closed form:
+
+    dp_i / dv_k = h (cos phi_k, sin phi_k)                                   (k < i)
+    dp_i / dw_k = R90 ((p_{k+1} - p_k) / 2 + (p_i - p_{k+1})) h              (k < i)
+
+(R90 rotates by +90 degrees; p_{k+1} - p_k = v_k h (cos phi_k, sin phi_k)). Everything is
+vectorised over the band: no Python loop per pose.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def rollout(pose0, v: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
+    """Poses (M+1, 3) from ``pose0`` driving the commands ``v``, ``w`` (M,) for ``h`` s each.
+    Headings are continuous (not wrapped)."""
+    theta = pose0[2] + h * np.concatenate([[0.0], np.cumsum(w)])
+    phi = theta[:-1] + 0.5 * h * w
+    poses = np.empty((len(v) + 1, 3))
+    poses[0, 0], poses[0, 1] = pose0[0], pose0[1]
+    poses[1:, 0] = pose0[0] + np.cumsum(h * v * np.cos(phi))
+    poses[1:, 1] = pose0[1] + np.cumsum(h * v * np.sin(phi))
+    poses[:, 2] = theta
+    return poses
+
+
+def position_jacobian(poses: np.ndarray, w: np.ndarray, h: float, lower: np.ndarray):
+    """d(x_i, y_i)/d(v, w) for the poses i = 1..M: two (M, 2M) arrays (columns v_0..v_{M-1}, then
+    w_0..w_{M-1}). ``lower[i-1, k]`` is True where k < i (precomputed by the caller)."""
+    M = len(w)
+    xy = poses[:, :2]
+    step = xy[1:] - xy[:-1]  # p_{k+1} - p_k
+    phi = poses[:-1, 2] + 0.5 * h * w
+    Jx = np.empty((M, 2 * M))
+    Jy = np.empty((M, 2 * M))
+    Jx[:, :M] = np.where(lower, h * np.cos(phi)[None, :], 0.0)
+    Jy[:, :M] = np.where(lower, h * np.sin(phi)[None, :], 0.0)
+    # lever arm of w_k on pose i: (p_{k+1} - p_k) / 2 + (p_i - p_{k+1}), rotated by +90 degrees
+    lever_x = 0.5 * step[None, :, 0] + (xy[1:, None, 0] - xy[None, 1:, 0])
+    lever_y = 0.5 * step[None, :, 1] + (xy[1:, None, 1] - xy[None, 1:, 1])
+    Jx[:, M:] = np.where(lower, -h * lever_y, 0.0)
+    Jy[:, M:] = np.where(lower, h * lever_x, 0.0)
+    return Jx, Jy
+
+
+def pursuit_commands(pose0, v_start: float, w_start: float, goal_xy, goal_vel, h: float, first_period: float,
+                     M: int, limits, reverse: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A deterministic first guess for the band: a simple pursuit of the moving goal, rolled out
+    for M segments within the velocity and acceleration limits.
+
+    The robot steers towards where the goal will be at the end of each segment and matches the
+    goal's velocity plus a proportional correction along its heading. With ``reverse`` it faces
+    the goal with whichever end is closer (the goal behind it is reached by slowing or reversing);
+    without, it turns its front towards the goal (a goal behind it means turning around).
+    """
+    x, y, th = float(pose0[0]), float(pose0[1]), float(pose0[2])
+    gx, gy = float(goal_xy[0]), float(goal_xy[1])
+    gvx, gvy = float(goal_vel[0]), float(goal_vel[1])
+    v_prev, w_prev = v_start, w_start
+    vs, ws = np.empty(M), np.empty(M)
+    tau_v, tau_w, look = 0.6, 0.35, 1.0  # s: time constants and look-ahead (only shape the first guess)
+    for k in range(M):
+        t = (k + 1) * h
+        rx, ry = gx + gvx * t - x, gy + gvy * t - y
+        c, s = math.cos(th), math.sin(th)
+        # steer towards where the goal will be ``look`` s later: well defined even on the goal
+        ax, ay = rx + gvx * look, ry + gvy * look
+        e = math.atan2(ay, ax) - th
+        e = math.atan2(math.sin(e), math.cos(e))
+        if reverse and abs(e) > 0.5 * math.pi:
+            e = e - math.copysign(math.pi, e)
+        v_des = (gvx * c + gvy * s) + (rx * c + ry * s) / tau_v
+        w_des = e / tau_w * min(1.0, math.hypot(ax, ay) / 0.3)
+        dt_acc = first_period if k == 0 else h
+        dv, dw = limits.acc_lim_x * dt_acc, limits.acc_lim_theta * dt_acc
+        v = min(max(v_des, v_prev - dv, -limits.max_vel_x_backwards), v_prev + dv, limits.max_vel_x)
+        w = min(max(w_des, w_prev - dw, -limits.max_vel_theta), w_prev + dw, limits.max_vel_theta)
+        phi = th + 0.5 * w * h
+        x += v * h * math.cos(phi)
+        y += v * h * math.sin(phi)
+        th += w * h
+        vs[k], ws[k] = v, w
+        v_prev, w_prev = v, w
+    return vs, ws

@@ -12,7 +12,6 @@ from lbgp.geometry import integrate_unicycle
 from lbgp.planner import (
     GOAL_IN_COLLISION, INVALID_INPUT, JACKAL_PLANNER, OK, TURTLEBOT2_PLANNER, TebPlanner, safe_stop,
 )
-from lbgp.planner.timing import time_segments
 
 FAR = np.array([50.0, 50.0, 0.0])  # a person far away: free space
 PRESETS = {"jackal": JACKAL_PLANNER, "turtlebot2": TURTLEBOT2_PLANNER}
@@ -136,18 +135,6 @@ def test_reset_makes_plans_reproducible():
     planner.reset()
     again = drive(planner, [0, 0, 0.3], np.array([2.0, 1.0, 0.0]), steps=10)[1]
     np.testing.assert_array_equal(first, again)
-
-
-def test_timing_is_time_optimal_for_a_straight_band():
-    # 10 segments of 0.2 m from rest, top speed 1 m/s, acceleration 1 m/s^2, stopping at the end
-    dt = time_segments(np.full(10, 0.2), np.zeros(10), 0.0, 0.0, 0.0, 1.0, 0.2, 1.0, 1.0, 1.0, 0.01)
-    # v^2 <= 2 a s from both ends: peak speed sqrt(2 * 1 * 1) capped at 1 m/s in the middle
-    assert dt[0] == pytest.approx(0.2 / math.sqrt(0.4))
-    assert dt[5] == pytest.approx(0.2)  # cruising at 1 m/s
-    assert dt[-1] == pytest.approx(dt[0])
-    # turning on the spot is timed by the angular limits
-    dt = time_segments(np.zeros(3), np.full(3, 0.5), 0.0, 0.0, 0.0, 1.0, 0.2, 2.0, 1.0, 100.0, 0.01)
-    assert np.all(dt >= 0.25 - 1e-12)
 
 
 # ---------------------------------------------------------------- closed loop in MuJoCo

@@ -45,11 +45,13 @@ class PlannerConfig:
     # end past this budget (at least one always runs); None: iterate to step_tolerance (simulation, reproducible)
     trust_region_v: float = 0.75  # m/s change of each segment's v per iteration
     trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
-    step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this
+    step_tolerance: float = 1e-2  # converged when no v (m/s) or w (rad/s) moves more than this
     turn_around_candidate: bool = True  # also solve a band that turns to face a goal behind the robot
+    wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
+    wait_margin: float = 0.3  # m beyond the safety distance that counts as near
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)
     osqp_max_iter: int = 4000
-    osqp_eps: float = 1e-4  # absolute and relative tolerance of every QP, then polished (exact active set)
+    osqp_eps: float = 1e-3  # absolute and relative tolerance of every QP, then polished (exact active set)
 
     @property
     def safety_distance(self) -> float:

@@ -55,14 +55,15 @@ def position_jacobian(poses: np.ndarray, w: np.ndarray, h: float, lower: np.ndar
 
 
 def pursuit_commands(pose0, v_start: float, w_start: float, goal_xy, goal_vel, h: float, first_period: float,
-                     M: int, limits, reverse: bool) -> tuple[np.ndarray, np.ndarray]:
+                     M: int, limits, reverse: bool, wait: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """A deterministic first guess for the band: a simple pursuit of the moving goal, rolled out
     for M segments within the velocity and acceleration limits.
 
     The robot steers towards where the goal will be at the end of each segment and matches the
     goal's velocity plus a proportional correction along its heading. With ``reverse`` it faces
     the goal with whichever end is closer (the goal behind it is reached by slowing or reversing);
-    without, it turns its front towards the goal (a goal behind it means turning around).
+    without, it turns its front towards the goal (a goal behind it means turning around). With
+    ``wait`` it brakes to a stop while steering (to let a person cross in front of it first).
     """
     x, y, th = float(pose0[0]), float(pose0[1]), float(pose0[2])
     gx, gy = float(goal_xy[0]), float(goal_xy[1])
@@ -80,7 +81,7 @@ def pursuit_commands(pose0, v_start: float, w_start: float, goal_xy, goal_vel, h
         e = math.atan2(math.sin(e), math.cos(e))
         if reverse and abs(e) > 0.5 * math.pi:
             e = e - math.copysign(math.pi, e)
-        v_des = (gvx * c + gvy * s) + (rx * c + ry * s) / tau_v
+        v_des = 0.0 if wait else (gvx * c + gvy * s) + (rx * c + ry * s) / tau_v
         w_des = e / tau_w * min(1.0, math.hypot(ax, ay) / 0.3)
         dt_acc = first_period if k == 0 else h
         dv, dw = limits.acc_lim_x * dt_acc, limits.acc_lim_theta * dt_acc

@@ -25,7 +25,9 @@ No hidden state: every call starts from the same deterministic first guess (a pu
 moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
 and velocity, person pose and velocity, goal) alone; OSQP's warm start only saves iterations.
 Local minima (TEB's remedy: several bands in distinct topologies): when the goal lies behind the
-robot, a second band that turns the robot around is solved too, and the cheaper one is kept.
+robot, a second band that turns the robot around is solved too; when the band passes near the
+person's predicted path, another that starts by braking (let the person cross first). The
+cheapest band is kept.
 
 A goal within the person's safety distance, bad input, a failed QP, or a next pose that would go
 deeper into the person's safety radius returns a safe stop (decelerate within limits) with a
@@ -171,11 +173,12 @@ class TebPlanner:
         if cfg.turn_around_candidate and self._goal_behind(problem):
             candidates.append("turn")
         best, iterations = None, 0
-        for name in candidates:
+        while candidates:
+            name = candidates.pop(0)
             if name != "keep" and self._over_budget(t_start, iterations):
                 break
             v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, goal[:2], goal_vel, self.h,
-                                      cfg.control_period, self.M, cfg, reverse=(name == "keep"))
+                                      cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations)
             iterations += done
             if status != OK:
@@ -183,6 +186,8 @@ class TebPlanner:
             cost = self._cost(problem, u)
             if best is None or cost < best[0] - 1e-9:
                 best = (cost, u, name)
+            if name == "keep" and cfg.wait_candidate and self._near_person(problem, u):
+                candidates.append("wait")  # the person's path is near this band: also try letting them pass
         _, u, name = best
         poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
         clearance = np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T)
@@ -198,6 +203,12 @@ class TebPlanner:
         x, y, th = problem.pose0
         g = problem.goal_path[self.M // 2]
         return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < 0.0
+
+    def _near_person(self, problem: _Problem, u: np.ndarray) -> bool:
+        """Whether the band driven by ``u`` comes within ``wait_margin`` of the safety distance."""
+        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
+        clearance = np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T)
+        return bool(clearance.min() < self.cfg.safety_distance + self.cfg.wait_margin)
 
     def _over_budget(self, t_start: float, iterations: int) -> bool:
         budget = self.cfg.sqp_time_budget

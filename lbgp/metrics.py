@@ -8,6 +8,35 @@ import math
 import numpy as np
 
 
+LOOP_ANGLE = math.pi  # rad: a loop turns the robot's heading (relative to the person's) through more than this
+
+
+class LoopDetector:
+    """Counts loops: stretches of an episode in which the robot's heading, relative to the
+    person's, turns through more than 180 degrees while the robot's goal stays ahead of the person
+    (a planner that circles instead of slowing down). Following a person round a U-turn turns the
+    robot with the person and is not a loop. Fed once per agent step."""
+
+    def __init__(self):
+        self.loops = 0
+        self._last = None  # unwrapped relative heading at the previous step of the current stretch
+        self._low = self._high = 0.0
+
+    def add(self, robot_yaw: float, person_yaw: float, goal_ahead: bool = True) -> None:
+        relative = math.remainder(robot_yaw - person_yaw, 2.0 * math.pi)
+        if not goal_ahead:
+            self._last = None
+            return
+        if self._last is None:
+            self._last = self._low = self._high = relative
+            return
+        self._last += math.remainder(relative - self._last, 2.0 * math.pi)
+        self._low, self._high = min(self._low, self._last), max(self._high, self._last)
+        if self._high - self._low > LOOP_ANGLE:
+            self.loops += 1
+            self._low = self._high = self._last  # each further half turn counts again
+
+
 @dataclasses.dataclass
 class EpisodeMetrics:
     setting: str = ""
@@ -16,11 +45,21 @@ class EpisodeMetrics:
     rewards: list = dataclasses.field(default_factory=list)
     contact: bool = False
     terminated_early: bool = False
+    loop_detector: LoopDetector = dataclasses.field(default_factory=LoopDetector)
 
-    def add(self, distance: float, alpha: float, reward: float) -> None:
+    def add(self, distance: float, alpha: float, reward: float, robot_yaw: float | None = None,
+            person_yaw: float | None = None, goal_ahead: bool = True) -> None:
+        """One agent step. With the two headings (rad) the step also feeds the loop detector;
+        ``goal_ahead``: the robot's goal lies in front of the person (True when there is no goal)."""
         self.distances.append(float(distance))
         self.alphas.append(float(alpha))
         self.rewards.append(float(reward))
+        if robot_yaw is not None and person_yaw is not None:
+            self.loop_detector.add(float(robot_yaw), float(person_yaw), goal_ahead)
+
+    @property
+    def loops(self) -> int:
+        return self.loop_detector.loops
 
     @property
     def steps(self) -> int:
@@ -44,7 +83,16 @@ class EpisodeMetrics:
             "alpha_std_deg": float(a.std()) if a.size else nan,
             "collision": bool(self.contact),
             "terminated_early": bool(self.terminated_early),
+            "loops": self.loops,
         }
+
+
+def goal_ahead_of_person(goal, person_pose) -> bool:
+    """Whether a world goal (x, y, ...) lies in front of the person (True when there is no goal)."""
+    if goal is None:
+        return True
+    c, s = math.cos(float(person_pose[2])), math.sin(float(person_pose[2]))
+    return c * (float(goal[0]) - float(person_pose[0])) + s * (float(goal[1]) - float(person_pose[1])) > 0.0
 
 
 def aggregate(episodes: list[EpisodeMetrics]) -> dict:
@@ -63,5 +111,6 @@ def aggregate(episodes: list[EpisodeMetrics]) -> dict:
         "reward_std": float(np.std(rewards)) if rewards else nan,
         "collisions": int(sum(e.contact for e in episodes)),
         "terminated_early": int(sum(e.terminated_early for e in episodes)),
+        "loops": int(sum(e.loops > 0 for e in episodes)),  # episodes with at least one loop
         "steps": float(np.mean([e.steps for e in episodes])) if episodes else nan,
     }

@@ -6,7 +6,7 @@ from typing import Protocol
 
 import numpy as np
 
-from lbgp.metrics import EpisodeMetrics
+from lbgp.metrics import EpisodeMetrics, goal_ahead_of_person
 
 
 class Policy(Protocol):
@@ -43,7 +43,8 @@ def run_episode(env, policy, recorder=None, episode_index: int = 0) -> EpisodeMe
     while not timestep.last():
         timestep = env.step(policy.act(timestep.observation))
         info = env.info()
-        metrics.add(info["distance"], info["alpha"], timestep.reward)
+        metrics.add(info["distance"], info["alpha"], timestep.reward, info["robot_pose"][2], info["person_pose"][2],
+                    goal_ahead_of_person(info["goal"], info["person_pose"]))
         metrics.contact = metrics.contact or bool(info["contact"])
         if recorder is not None:
             recorder.log_step(info, timestep.reward)

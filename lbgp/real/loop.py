@@ -185,7 +185,8 @@ class DeployLoop:
         observation = self.stack.vector()
         self.controller.set_action(self.policy.act(observation), state)
         reward = follow_ahead_reward(distance, alpha)
-        self.metrics.add(distance, alpha, reward)
+        goal = getattr(self.controller, "goal_person", None)  # None: the policy commands (v, w) itself
+        self.metrics.add(distance, alpha, reward, state.robot_pose[2], state.person_pose[2], goal is None or goal[0] > 0.0)
         self.agent_steps += 1
         record.agent_step = True
         record.observation = observation

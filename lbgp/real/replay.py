@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 
 from lbgp.geometry import distance_and_alpha
-from lbgp.metrics import EpisodeMetrics
+from lbgp.metrics import EpisodeMetrics, goal_ahead_of_person
 from lbgp.real.mcap_log import frames_of, pose_of, read_log
 from lbgp.sim.rewards import follow_ahead_reward
 
@@ -33,7 +33,7 @@ def replay_log(path, recorder=None) -> tuple[EpisodeMetrics, dict]:
             continue
         distance, alpha = distance_and_alpha(frame.robot, frame.person)
         reward = follow_ahead_reward(distance, alpha)
-        metrics.add(distance, alpha, reward)
+        metrics.add(distance, alpha, reward, frame.robot[2], frame.person[2], goal_ahead_of_person(goals.get(key), frame.person))
         if recorder is not None:
             recorder.log_step({"time": frame.t, "distance": distance, "alpha": alpha, "robot_pose": frame.robot,
                                "person_pose": frame.person, "goal": goals.get(key), "band": bands.get(key)}, reward)

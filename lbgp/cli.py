@@ -109,27 +109,65 @@ def cmd_train(args) -> int:
     return 130 if summary.get("interrupted") else 0
 
 
+def _stop_on_signals():
+    """SIGTERM and SIGHUP end ``lbgp deploy`` as Ctrl-C does (zero command, summary, closed log);
+    returns the previous handlers. A second signal while stopping is ignored."""
+    import signal
+
+    from lbgp.real.loop import StopRequested
+
+    stopping = []
+
+    def handler(number, frame):
+        if not stopping:
+            stopping.append(number)
+            raise StopRequested(signal.Signals(number).name)
+
+    previous = {}
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+        if sig is not None:
+            previous[sig] = signal.signal(sig, handler)
+    return previous
+
+
 def cmd_deploy(args) -> int:
+    import signal
+
     from lbgp.policies import make_policy
     from lbgp.real.deploy import deploy
 
     policy = make_policy(args.method, args.policy)
     print(f"lbgp deploy: {args.method} policy, source {args.source}, sink {args.sink or 'default'}, robot {args.robot}"
-          + (f", logging to {args.log}" if args.log else ""))
-    loop = None
+          + (f", logging to {args.log}" if args.log else ""), flush=True)
+    previous = _stop_on_signals()
     try:
         loop = deploy(policy, source=args.source, sink=args.sink, robot=args.robot, steps=args.steps, log=args.log,
                       record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
                       planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
                       metadata={"method": args.method, "policy": args.policy or "default"})
-    except KeyboardInterrupt:
-        print("interrupted: a zero command was sent")
+    except KeyboardInterrupt:  # before the loop ran (opening the source, the log, the viewer)
+        print("interrupted before the loop started: no command was sent", file=sys.stderr)
         return 130
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     summary = {"end": loop.end_reason, "ticks": loop.ticks, "agent_steps": loop.agent_steps, **loop.metrics.summary(),
                "rejected_frames": loop.monitor.counts}
+    if loop.error is not None:
+        summary["error"] = f"{type(loop.error).__name__}: {loop.error}"
     print(json.dumps(summary, indent=2))
     if args.json:
         _write_json_atomic(Path(args.json), summary)
+    if loop.error is not None:
+        print(f"lbgp deploy: error: {summary['error']} (a zero command was sent)", file=sys.stderr)
+        return 1
+    if loop.end_reason == "interrupted":
+        print("interrupted: a zero command was sent", file=sys.stderr)
+        return 130
+    if loop.end_reason.startswith("signal "):
+        name = loop.end_reason.split()[1]
+        print(f"stopped by {name}: a zero command was sent", file=sys.stderr)
+        return 128 + int(getattr(signal, name))
     return 0
 
 

@@ -196,3 +196,62 @@ def test_anytime_budget_caps_the_sqp_iterations_and_still_reaches_the_goal():
     poses, cmds, statuses = drive(TebPlanner(tight), [0, 0, 0], np.array([3.0, 1.0, 0.0]), steps=100)
     assert np.linalg.norm(poses[-1][:2] - [3.0, 1.0]) < 0.1
     assert all(abs(v) <= tight.max_vel_x + 1e-9 and abs(w) <= tight.max_vel_theta + 1e-9 for v, w in cmds)
+
+
+# ---------------------------------------------------------------- no hidden state, smooth in the goal
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    robot=st.sampled_from(sorted(PRESETS)),
+    state=st.tuples(*[st.floats(-1.0, 1.0)] * 9),
+    previous=st.tuples(*[st.floats(-1.0, 1.0)] * 4),
+)
+def test_warm_and_cold_calls_agree_and_respect_the_limits(robot, state, previous):
+    """The command depends on (robot pose and velocity, person pose and velocity, goal) only: a
+    planner that has just planned for another situation (OSQP warm start) commands what a fresh one
+    does, within 0.05 m/s and 0.1 rad/s; limits always hold; never NaN."""
+    cfg = PRESETS[robot]
+    yaw, v, w, px, py, pyaw, pv, gx, gy = state
+    robot_pose = [0.0, 0.0, math.pi * yaw]
+    velocity = (cfg.max_vel_x * max(v, 0.0) - cfg.max_vel_x_backwards * max(-v, 0.0), cfg.max_vel_theta * w)
+    person = np.array([2.0 * px, 2.0 * py, math.pi * pyaw])
+    person_vel = 0.8 * pv * np.array([math.cos(person[2]), math.sin(person[2])])
+    goal = person[:2] + 1.5 * np.array([math.cos(person[2]), math.sin(person[2])]) + 0.75 * np.array([gx, gy])
+    args = (robot_pose, velocity, goal, person, person_vel)
+    cold = TebPlanner(cfg).plan(*args, goal_velocity=person_vel)
+    warm = TebPlanner(cfg)
+    a, b, c, d = previous
+    warm.plan([a, b, c], (0.3 * d, 0.0), [3 * a + 1, 2 * b], [5.0 * c, -5.0, 0.0], (0.5 * d, 0.2), goal_velocity=(0.5 * d, 0.2))
+    again = warm.plan(*args, goal_velocity=person_vel)
+    assert cold.status == again.status
+    assert abs(cold.v - again.v) <= 0.05 and abs(cold.w - again.w) <= 0.1
+    for plan in (cold, again):
+        assert math.isfinite(plan.v) and math.isfinite(plan.w)
+        assert -cfg.max_vel_x_backwards - 1e-9 <= plan.v <= cfg.max_vel_x + 1e-9
+        assert abs(plan.w) <= cfg.max_vel_theta + 1e-9
+        assert abs(plan.v - velocity[0]) <= cfg.acc_lim_x * cfg.control_period + 1e-9
+        assert abs(plan.w - velocity[1]) <= cfg.acc_lim_theta * cfg.control_period + 1e-9
+
+
+def test_a_goal_just_behind_a_robot_moving_with_the_person_slows_it_down_instead_of_turning():
+    """The cliff of the planner issue: robot 1.5 m ahead of a person walking at 0.6 m/s, already at
+    the person's speed, goal 10 cm behind it: slow down a little, keep the heading."""
+    planner = TebPlanner(JACKAL_PLANNER)
+    plan = planner.plan([1.5, 0.0, 0.0], (0.6, 0.0), [1.4, 0.0], [0.0, 0.0, 0.0], (0.6, 0.0), goal_velocity=(0.6, 0.0))
+    assert plan.ok
+    assert 0.0 < plan.v < 0.6 and abs(plan.w) < 0.05
+    assert np.all(np.abs(np.diff(plan.poses[:, 2])) < 0.05)  # the band does not turn around
+
+
+def test_constant_goal_reward_is_smooth_in_the_goal_and_never_loops():
+    """A quick version of benchmarks/goal_sweep.py (Jackal, goals 1.3-1.7 m straight ahead)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from goal_sweep import summarise, sweep
+
+    result = sweep("jackal", scenarios=("straight_ahead", "turning_ahead"), xs=np.round(np.arange(1.3, 1.71, 0.05), 2), ys=(0.0,))
+    summary = summarise(result)
+    assert summary["largest_neighbour_change"] <= 3.0, summary
+    assert summary["straight_ahead_min_1_2_to_1_8"] >= 20.0, summary
+    assert summary["loops"] == 0

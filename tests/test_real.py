@@ -281,8 +281,14 @@ def test_ctrl_c_or_an_exception_sends_a_zero_command_before_exit(error):
             return np.array([1.0, 0.0], np.float32)
 
     sink = ListSink()
-    with pytest.raises(error):
-        DeployLoop(FixedPoses([0, 0, 0], [-1.5, 0, 0]), sink, Failing(), DeployConfig(), clock=ReplayClock()).run()
+    loop = DeployLoop(FixedPoses([0, 0, 0], [-1.5, 0, 0]), sink, Failing(), DeployConfig(), clock=ReplayClock())
+    if error is KeyboardInterrupt:  # Ctrl-C ends the run normally, the reason recorded
+        loop.run()
+        assert loop.end_reason == "interrupted"
+    else:
+        with pytest.raises(error):
+            loop.run()
+        assert loop.end_reason == "error"
     assert sink.sent[-2][1] > 0 and sink.sent[-1] == (SHUTDOWN, 0.0, 0.0)
 
 

@@ -40,12 +40,13 @@ class PlannerConfig:
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
     regularization: float = 1e-4  # proximal (Levenberg-Marquardt) term of each SQP step
     # sequential QP
-    sqp_iterations: int = 8  # at most, per candidate band; stops earlier at step_tolerance
+    sqp_iterations: int = 5  # at most, per candidate band; stops earlier at step_tolerance
     sqp_time_budget: float | None = None  # s: anytime mode (deployment): no further SQP iteration once it would
     # end past this budget (at least one always runs); None: iterate to step_tolerance (simulation, reproducible)
     trust_region_v: float = 0.75  # m/s change of each segment's v per iteration
     trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
-    step_tolerance: float = 1e-2  # converged when no v (m/s) or w (rad/s) moves more than this
+    step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this,
+    cost_tolerance: float = 0.0  # or when the objective falls by less than this share in an iteration
     turn_around_candidate: bool = True  # also solve a band that turns to face a goal behind the robot
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
     wait_margin: float = 0.3  # m beyond the safety distance that counts as near

@@ -23,7 +23,8 @@ up once, every later solve only updates values.
 
 No hidden state: every call starts from the same deterministic first guess (a pursuit of the
 moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
-and velocity, person pose and velocity, goal) alone; OSQP's warm start only saves iterations.
+and velocity, person pose and velocity, goal) alone; OSQP's warm start (the previous QP's solution)
+only saves ADMM iterations: every QP is solved to ``osqp_eps`` and polished.
 Local minima (TEB's remedy: several bands in distinct topologies): when the goal lies behind the
 robot, a second band that turns the robot around is solved too; when the band passes near the
 person's predicted path, another that starts by braking (let the person cross first). The
@@ -123,7 +124,7 @@ class TebPlanner:
         self.N, self.M = N, N - 1
         self.h = float(self.cfg.band_dt)
         self._solver = None
-        self.stats = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "inaccurate": 0}
+        self.stats = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "inaccurate": 0, "unpolished": 0}
         self._setup_structure()
 
     # ------------------------------------------------------------------ public
@@ -321,9 +322,12 @@ class TebPlanner:
                      + cfg.weight_clearance_slack * violation @ violation + cfg.weight_clearance_l1 * violation.sum())
 
     def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int):
-        """SQP from the commands ``u``; returns (u, status, iterations)."""
+        """SQP from the commands ``u``; returns (u, status, iterations). Converged when no command
+        moves more than ``step_tolerance`` or the objective falls by less than ``cost_tolerance``
+        (relative) in an iteration."""
         cfg, M = self.cfg, self.M
         u = np.clip(u, self._u_lo, self._u_hi)
+        cost = self._cost(problem, u)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
@@ -335,7 +339,8 @@ class TebPlanner:
             u = np.clip(u + step, self._u_lo, self._u_hi)
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
-            if float(np.max(np.abs(step))) < cfg.step_tolerance:
+            previous, cost = cost, self._cost(problem, u)
+            if float(np.max(np.abs(step))) < cfg.step_tolerance or previous - cost < cfg.cost_tolerance * previous:
                 break
         return u, OK, done
 
@@ -393,6 +398,8 @@ class TebPlanner:
             self.stats["max_iter_hits"] += 1
         if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
             self.stats["inaccurate"] += 1
+        if info.status_polish != 1:  # polishing did not confirm the active set: accurate to osqp_eps only
+            self.stats["unpolished"] += 1
         if status in _INFEASIBLE:
             return None, INFEASIBLE
         if status not in _SOLVED:

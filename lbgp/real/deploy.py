@@ -9,8 +9,9 @@ from lbgp.real.loop import DeployConfig, DeployLoop
 def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
            log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
            end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None):
-    """Run the loop until ``steps`` agent steps (or the source ends, or Ctrl-C); returns the loop
-    (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``)."""
+    """Run the loop until ``steps`` agent steps (or the source ends, Ctrl-C or a signal); returns the
+    loop (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``; an exception raised
+    while it ran is in ``loop.error``, after the zero command was sent and the log closed)."""
     pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance)
     command_sink = open_sink(sink or ("sim" if world is not None else "none"), world=world)
     logger = recorder = None
@@ -27,7 +28,11 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
         loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance,
                                                                                  planner_time_budget=planner_time_budget),
                           logger=logger, recorder=recorder, end_condition=end_condition)
-        loop.run()
+        loop.error = None
+        try:
+            loop.run()
+        except Exception as exc:  # the loop already sent zero and closed its log; let the caller report
+            loop.error = exc
         return loop
     finally:
         if logger is not None:

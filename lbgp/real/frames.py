@@ -18,8 +18,22 @@ import math
 import numpy as np
 
 
+MAX_FRAME_BYTES = 4096  # a pose frame is ~100 bytes; anything longer is dropped before parsing
+
+
 class FrameError(ValueError):
     """A datagram that is not a well-formed pose frame or command."""
+
+
+def _json(data: bytes, what: str):
+    """Parse one datagram's JSON; every way it can fail (size, encoding, syntax, nesting too deep
+    for the parser) is a FrameError."""
+    if len(data) > MAX_FRAME_BYTES:
+        raise FrameError(f"{what} of {len(data)} bytes is longer than {MAX_FRAME_BYTES}")
+    try:
+        return json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError, ValueError) as exc:
+        raise FrameError(f"not a JSON {what}: {type(exc).__name__}") from None
 
 
 @dataclasses.dataclass
@@ -38,7 +52,7 @@ def _pose(value, what: str) -> np.ndarray:
     # monitor to reject, so that they are counted and logged rather than silently dropped
     try:
         pose = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError, RecursionError):
         raise FrameError(f"{what} must be [x, y, yaw] numbers, got {value!r}") from None
     if pose.shape != (3,):
         raise FrameError(f"{what} must be [x, y, yaw], got {value!r}")
@@ -50,15 +64,12 @@ def encode_frame(frame: PoseFrame) -> bytes:
 
 
 def decode_frame(data: bytes) -> PoseFrame:
-    try:
-        msg = json.loads(data.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise FrameError(f"not a JSON pose frame: {exc}") from None
+    msg = _json(data, "pose frame")
     if not isinstance(msg, dict) or not {"t", "robot", "person"} <= msg.keys():
         raise FrameError("a pose frame needs the keys t, robot and person")
     try:
         t = float(msg["t"])
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise FrameError(f"t must be a number, got {msg['t']!r}") from None
     return PoseFrame(t, _pose(msg["robot"], "robot"), _pose(msg["person"], "person"))
 
@@ -68,10 +79,10 @@ def encode_command(t: float, v: float, w: float, status: str = "ok") -> bytes:
 
 
 def decode_command(data: bytes) -> tuple[float, float, float, str]:
+    msg = _json(data, "command")
     try:
-        msg = json.loads(data.decode("utf-8"))
         out = float(msg["t"]), float(msg["v"]), float(msg["w"]), str(msg.get("status", "ok"))
-    except (UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as exc:
         raise FrameError(f"not a JSON command: {exc!r}") from None
     if not all(math.isfinite(x) for x in out[:3]):
         raise FrameError(f"command has non-finite numbers: {out[:3]}")

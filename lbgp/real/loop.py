@@ -15,7 +15,8 @@ ramp the command to zero within ``SafetyConfig.stop_time``. Every second tick is
 (policy + observation frame + metrics). The robot's velocity for the planner is the last command
 sent (a robot without odometry feedback follows its commands); the person's velocity is a finite
 difference of its poses over one agent period, exactly as in simulation. Whatever ends the loop
-(its step budget, the source ending, Ctrl-C, an exception) a zero command is sent last.
+(its step budget, the source ending, Ctrl-C or a signal, an exception) a zero command is sent last;
+Ctrl-C and signals end ``run`` normally (``end_reason`` says which), exceptions propagate.
 """
 
 from __future__ import annotations
@@ -39,6 +40,15 @@ from lbgp.sim.robots import get_robot
 from lbgp.world import WorldState
 
 SHUTDOWN = "shutdown"
+
+
+class StopRequested(KeyboardInterrupt):
+    """A signal (SIGTERM from systemd, docker stop or kill; SIGHUP from a dropped SSH session) asked
+    the deployment to end: the loop ends as it does on Ctrl-C (zero command, closed log, summary)."""
+
+    def __init__(self, signal_name: str):
+        super().__init__(signal_name)
+        self.signal_name = signal_name
 DEPLOY_DEFAULT_BUDGET = 0.002  # s of SQP per planner call in ``lbgp deploy`` (see docs/deploy.md, "Latency")
 
 
@@ -227,18 +237,19 @@ class DeployLoop:
                 next_tick += period
                 if self.clock.now() > next_tick + period:  # fell behind (slow machine): do not burst
                     next_tick = self.clock.now()
-        except KeyboardInterrupt:
-            self.end_reason = "interrupted"
-            raise
+        except KeyboardInterrupt as exc:  # Ctrl-C, or a signal turned into StopRequested: a normal end
+            self.end_reason = f"signal {exc.signal_name}" if isinstance(exc, StopRequested) else "interrupted"
         except BaseException:
             self.end_reason = "error"
             raise
         finally:
             self.command = (0.0, 0.0)
-            self.sink.send(self.clock.now(), 0.0, 0.0, SHUTDOWN)
-            if self.logger is not None:
-                self.logger.log_tick(TickRecord(self.clock.now(), SHUTDOWN, 0.0, 0.0))
-                self.logger.close()
+            try:
+                self.sink.send(self.clock.now(), 0.0, 0.0, SHUTDOWN)
+            finally:
+                if self.logger is not None:
+                    self.logger.log_tick(TickRecord(self.clock.now(), SHUTDOWN, 0.0, 0.0))
+                    self.logger.close()
         self.metrics.contact = self.end_reason == "contact"
         self.metrics.terminated_early = self.end_reason not in ("steps", "duration", "source_ended", "")
         return self.metrics

@@ -18,14 +18,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import socket
 import threading
 import time
 
 import numpy as np
 
 from lbgp.real.frames import PoseFrame, encode_frame
-from lbgp.real.udp import UdpCommandListener
+from lbgp.real.udp import UdpCommandListener, sending_socket
 from lbgp.sim import tasks
 from lbgp.sim.robots import get_robot
 
@@ -187,7 +186,7 @@ class SimRobotServer:
         self.world = world
         self.pose_to = tuple(pose_to)
         self.commands = UdpCommandListener(command_bind, allowed_senders)
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock = sending_socket(self.pose_to)
         self.max_duration = max_duration
         self.faults = faults
         self.received: list[tuple[float, float, float, str]] = []  # (sim time, v, w, status)
@@ -219,7 +218,10 @@ class SimRobotServer:
             delayed += [(now + delay, data) for delay, data in out]
             delayed.sort(key=lambda item: item[0])
             while delayed and delayed[0][0] <= now:
-                self.sock.sendto(delayed.pop(0)[1], self.pose_to)
+                try:
+                    self.sock.send(delayed.pop(0)[1])
+                except ConnectionRefusedError:  # the loop is not listening (yet, or any more)
+                    pass
             next_frame = start + index * FRAME_PERIOD
             time.sleep(max(0.0, next_frame - time.monotonic()))
 

@@ -12,8 +12,9 @@ import select
 import socket
 
 from lbgp.real.frames import FrameError, PoseFrame, decode_command, decode_frame, encode_command
+from lbgp.real.throttle import ThrottledLog
 
-log = logging.getLogger(__name__)
+log = ThrottledLog(logging.getLogger(__name__))
 MAX_DATAGRAM = 65_507
 
 
@@ -32,7 +33,11 @@ def parse_address(text: str, default_host: str = "127.0.0.1") -> tuple[str, int]
 class _Listener:
     def __init__(self, bind=("127.0.0.1", 0), allowed_senders=("127.0.0.1",)):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.sock.bind(tuple(bind))
+        try:
+            self.sock.bind(tuple(bind))
+        except OSError as exc:
+            self.sock.close()
+            raise ValueError(f"cannot listen on {bind[0]}:{bind[1]}: {exc.strerror or exc}") from None
         self.sock.setblocking(False)
         self.allowed = {self._norm(s) for s in allowed_senders}
         self.rejected_senders = 0
@@ -62,7 +67,7 @@ class _Listener:
                 break
             if not self._allowed(addr):
                 self.rejected_senders += 1
-                log.warning("dropped a datagram from %s:%s (not an allowed sender)", *addr)
+                log.warning("sender", "dropped a datagram from %s:%s (not an allowed sender)", *addr)
                 continue
             yield data
 
@@ -84,22 +89,48 @@ class UdpPoseSource(_Listener):
                 frame = decode_frame(data)
             except FrameError as exc:
                 self.malformed += 1
-                log.warning("dropped a malformed pose datagram: %s", exc)
+                log.warning("malformed", "dropped a malformed pose datagram: %s", exc)
                 continue
             frame.received = now
             frames.append(frame)
         return frames
 
 
-class UdpCommandSink:
-    """Send each command as a JSON datagram to the robot's listener."""
+def sending_socket(destination: tuple[str, int], bind: tuple[str, int] | None = None) -> socket.socket:
+    """A UDP socket that only sends to ``destination``: bound to ``bind`` if given, else to the
+    loopback address for a loopback destination, else to the one local address that routes to the
+    destination (never all interfaces), and connected, so the kernel drops anything that arrives
+    from another address; its receive buffer is kept minimal, since nothing reads it."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1)
+        host = destination[0]
+        if bind is not None:
+            sock.bind(tuple(bind))
+        elif host == "localhost" or host.startswith("127."):
+            sock.bind(("127.0.0.1", 0))
+        sock.connect(tuple(destination))  # binds the routed local address when not bound yet
+    except OSError:
+        sock.close()
+        raise
+    return sock
 
-    def __init__(self, address: tuple[str, int]):
+
+class UdpCommandSink:
+    """Send each command as a JSON datagram to the robot's listener (see ``sending_socket``)."""
+
+    def __init__(self, address: tuple[str, int], bind: tuple[str, int] | None = None):
         self.address = tuple(address)
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            self.sock = sending_socket(self.address, bind)
+        except OSError as exc:
+            raise ValueError(f"cannot send commands to {self.address[0]}:{self.address[1]}: {exc.strerror or exc}") from None
 
     def send(self, t: float, v: float, w: float, status: str = "ok") -> None:
-        self.sock.sendto(encode_command(t, v, w, status), self.address)
+        try:
+            self.sock.send(encode_command(t, v, w, status))
+        except ConnectionRefusedError:  # nobody listening yet (ICMP port unreachable): the next one may land
+            pass
 
     def close(self) -> None:
         self.sock.close()
@@ -115,5 +146,5 @@ class UdpCommandListener(_Listener):
                 out.append(decode_command(data))
             except FrameError as exc:
                 self.malformed += 1
-                log.warning("dropped a malformed command datagram: %s", exc)
+                log.warning("malformed", "dropped a malformed command datagram: %s", exc)
         return out

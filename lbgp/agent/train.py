@@ -9,8 +9,10 @@ A run directory holds:
                       ``checkpoint_every_s`` and at the end or on Ctrl-C / SIGTERM)
     policy.pt         the final policy file (see lbgp.agent.policy)
     summary.json      final counters and returns
+    run.lock          held by the training process that uses the folder (a second one is refused)
 
-``--resume DIR`` reloads checkpoint.pt, drops curve rows newer than it, and continues.
+``--resume DIR`` removes temporary files a killed run left (``*.tmp``), reloads checkpoint.pt,
+drops curve rows newer than it, and continues.
 """
 
 from __future__ import annotations
@@ -65,6 +67,43 @@ def read_curve(path: str | os.PathLike) -> list[dict]:
     return rows
 
 
+class RunLock:
+    """``run.lock`` in the run folder, held (flock) for as long as a training process uses the
+    folder: a second ``lbgp train`` on the same folder is refused from the first moment, and a lock
+    left by a killed run (no process holds it any more) is taken over."""
+
+    def __init__(self, run_dir: Path):
+        import fcntl
+
+        self.path = Path(run_dir) / "run.lock"
+        if not self.path.parent.is_dir():
+            raise FileNotFoundError(f"{self.path.parent}: no such run folder")
+        self._file = self.path.open("a+")
+        try:
+            fcntl.flock(self._file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self._file.seek(0)
+            holder = self._file.read().strip() or "?"
+            self._file.close()
+            raise ValueError(f"{self.path.parent} is in use by another lbgp train (pid {holder}); wait for it or pick another --out") from None
+        self._file.seek(0)
+        self._file.truncate()
+        self._file.write(f"{os.getpid()}\n")
+        self._file.flush()
+
+    def release(self) -> None:
+        if not self._file.closed:
+            self._file.close()  # closing drops the flock; the file stays (harmless, reused next time)
+
+
+def remove_stale_temporaries(run_dir: Path) -> list[Path]:
+    """Temporary files a killed or disk-full run left behind (atomic writes that never finished)."""
+    stale = [p for p in Path(run_dir).iterdir() if p.is_file() and p.name.endswith(".tmp")]
+    for p in stale:
+        p.unlink()
+    return stale
+
+
 class Trainer:
     def __init__(self, cfg: D4PGConfig, run_dir: str | os.PathLike, resume: bool = False, backend: str = "processes", progress: bool = True):
         self.cfg = cfg.validate()
@@ -84,11 +123,19 @@ class Trainer:
         self.restarts = 0
         self.level_times: dict[str, float] = {}
         self.recent_exploit: list[float] = []
-        if resume:
-            self.load_checkpoint()
-        else:
+        if not resume:
             self.dir.mkdir(parents=True, exist_ok=True)
-            if (self.dir / "checkpoint.pt").exists():
+        self.lock = RunLock(self.dir)  # before anything in the folder is read or written
+        if resume:
+            remove_stale_temporaries(self.dir)
+            try:
+                self.load_checkpoint()
+            except BaseException:
+                self.lock.release()
+                raise
+        else:
+            if any((self.dir / name).exists() for name in ("checkpoint.pt", "config.json", "curve.csv")):
+                self.lock.release()
                 raise ValueError(f"{self.dir} already holds a run; use --resume {self.dir} to continue it or pick another --out")
             (self.dir / "config.json").write_text(cfg.to_json() + "\n")
             with (self.dir / "curve.csv").open("w", newline="") as f:
@@ -228,8 +275,11 @@ class Trainer:
             actors.stop()  # transitions still in flight are dropped: the checkpoint below is the state
             if bar is not None:
                 bar.close()
-        self.checkpoint()
-        return self._finish(interrupted)
+        try:
+            self.checkpoint()
+            return self._finish(interrupted)
+        finally:
+            self.lock.release()
 
     def _on_sigterm(self, signum, frame):
         raise Stop()

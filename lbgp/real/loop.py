@@ -148,6 +148,8 @@ class DeployLoop:
         frame = self.monitor.last
         record = TickRecord(now, status, 0.0, 0.0)
         if status == safety_lib.OK:
+            if now - self._last_good > self.cfg.safety.reanchor_after:
+                self._people.clear()  # first data, or back after a long gap (the source's clock may have restarted)
             if not self._people or self._people[-1][0] < frame.t:
                 self._people.append((frame.t, frame.person.copy()))
             record.robot, record.person = frame.robot.copy(), frame.person.copy()

@@ -20,6 +20,7 @@ import json
 import math
 import os
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -65,6 +66,12 @@ class LogError(ValueError):
     """A file that is not a readable lbgp MCAP log."""
 
 
+# What the mcap reader and the ROS 2 decoder raise on a cut or corrupted file: their own errors, and
+# those of the bytes underneath (struct unpacking, zstd/lz4 frames, absurd lengths, bad UTF-8,
+# CDR decoding). A damaged log is data, not a bug: it reads up to the damage or gives a LogError.
+_DAMAGED = (Exception,)
+
+
 def _stamp(ns: int) -> dict:
     return {"sec": int(ns // 1_000_000_000), "nanosec": int(ns % 1_000_000_000)}
 
@@ -92,11 +99,24 @@ class McapLogger:
         self._writer._writer.add_metadata(LOG_METADATA, meta)
         self._t0_ns = time.time_ns()
         self._closed = False
+        self.failed: OSError | None = None  # the error that stopped logging, if one did
 
     def _write(self, topic: str, msg: dict, ns: int) -> None:
         self._writer.write_message(topic, self._schemas[TOPICS[topic]], msg, log_time=ns, publish_time=ns)
 
     def log_tick(self, record) -> None:
+        """Log one tick. A failing disk (full, removed) never stops the robot's loop: the log stops
+        with a warning, and what was flushed before stays readable."""
+        if self.failed is not None or self._closed:
+            return
+        try:
+            self._log_tick(record)
+        except OSError as exc:
+            self.failed = exc
+            warnings.warn(f"{self.path}: logging stopped ({exc.strerror or exc}); the file reads up to its last flushed chunk",
+                          RuntimeWarning, stacklevel=2)
+
+    def _log_tick(self, record) -> None:
         ns = self._t0_ns + int(round(record.t * 1e9))
         if record.robot is not None:
             self._write("/robot/pose", _pose_msg(record.robot, ns), ns)
@@ -118,14 +138,21 @@ class McapLogger:
     def close(self) -> None:
         if not self._closed:
             self._closed = True
-            self._writer.finish()
-            self._file.close()
+            try:
+                if self.failed is None:
+                    self._writer.finish()
+            except OSError as exc:
+                self.failed = exc
+            finally:
+                try:
+                    self._file.close()
+                except OSError:
+                    pass
 
 
 def read_log(path: str | os.PathLike) -> dict:
     """Messages of an lbgp log by topic, as (t seconds from the first message, decoded message)
     pairs, plus ``metadata`` and ``truncated`` (the file ended inside a chunk: a killed run)."""
-    from mcap.exceptions import McapError
     from mcap.reader import NonSeekingReader
     from mcap_ros2.decoder import DecoderFactory
 
@@ -143,7 +170,7 @@ def read_log(path: str | os.PathLike) -> dict:
                 if record.name == LOG_METADATA:
                     metadata = dict(record.metadata)
                     break
-        except (McapError, EOFError, ValueError, OSError):
+        except _DAMAGED:
             pass
         if metadata is None:
             raise LogError(f"{path}: not an lbgp log (no '{LOG_METADATA}' metadata record; was it written by lbgp deploy --log?)")
@@ -153,12 +180,12 @@ def read_log(path: str | os.PathLike) -> dict:
             for schema, channel, message, decoded in reader.iter_decoded_messages(topics=list(TOPICS), log_time_order=False):
                 t0 = message.log_time if t0 is None else t0
                 out[channel.topic].append(((message.log_time - t0) / 1e9, decoded))
-        except (McapError, EOFError, ValueError, OSError) as exc:
+        except _DAMAGED as exc:
             if not any(out.values()):
                 raise LogError(f"{path}: cannot read MCAP records ({type(exc).__name__}: {exc})") from None
             truncated = True
     if not out["/robot/pose"]:
-        raise LogError(f"{path}: an lbgp log without any pose messages")
+        raise LogError(f"{path}: an lbgp log without any pose messages" + (" (damaged after its metadata)" if truncated else ""))
     out["metadata"] = metadata
     out["truncated"] = truncated
     return out

@@ -18,10 +18,19 @@ def _key(t: float) -> float:
     return round(t, 6)
 
 
+def _status(msg) -> dict:
+    """A /lbgp/status message's JSON ({} when a damaged log garbled it)."""
+    try:
+        status = json.loads(msg.data)
+    except (ValueError, TypeError, RecursionError):
+        return {}
+    return status if isinstance(status, dict) else {}
+
+
 def replay_log(path, recorder=None) -> tuple[EpisodeMetrics, dict]:
     """Metrics of a log's agent steps (D, alpha, reward from the logged poses), as the loop computed them."""
     log = read_log(path)
-    steps = {_key(t) for t, m in log["/lbgp/status"] if json.loads(m.data).get("agent_step")}
+    steps = {_key(t) for t, m in log["/lbgp/status"] if _status(m).get("agent_step")}
     goals = {_key(t): pose_of(m) for t, m in log["/lbgp/goal"]}
     bands = {_key(t): [pose_of(p) for p in m.poses] for t, m in log["/lbgp/plan"]}
     metrics = EpisodeMetrics(setting=log["metadata"].get("setting", "replay"))

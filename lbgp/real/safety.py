@@ -6,8 +6,11 @@ moved more than ``max_jump`` metres since the last accepted frame (no person or 
 mocap swap or glitch can). The data is *stale* when no frame was accepted for ``stale_after``
 seconds, and the loop also stops the robot at once when the newest frame of a tick was rejected;
 it drives again as soon as good frames return. After
-``reanchor_after`` seconds without an accepted frame the jump check starts afresh from the next
-finite, in-order frame (the bodies may really have moved far during a long dropout).
+``reanchor_after`` seconds (1 s) without an accepted frame the next finite frame becomes the new
+anchor, whatever its timestamp and position: the bodies may really have moved far during a long
+dropout, and a sender whose clock restarted (a mocap restart) or one frame stamped far in the
+future (which makes every later good frame look out of order) blocks good data for at most that
+long.
 
 Independent of the data, the robot stops whenever it is closer than ``min_distance`` to the
 person, whatever the policy wants.
@@ -52,10 +55,12 @@ class SafetyMonitor:
         if not frame.is_finite():
             return self._reject(NON_FINITE)
         last = self.last
+        if last is not None and frame.received - last.received > self.cfg.reanchor_after:
+            last = None  # nothing accepted for a while: this frame is the new anchor (time and place)
         if last is not None:
             if frame.t <= last.t:
                 return self._reject(OUT_OF_ORDER)
-            if frame.received - last.received <= self.cfg.reanchor_after and (
+            if (
                 np.hypot(*(frame.robot[:2] - last.robot[:2])) > self.cfg.max_jump
                 or np.hypot(*(frame.person[:2] - last.person[:2])) > self.cfg.max_jump
             ):

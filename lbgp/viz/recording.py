@@ -17,11 +17,15 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import rerun as rr
 
+VIEWER_PORT = 9876  # rerun's default gRPC port, served on 127.0.0.1 by the viewer lbgp spawns
 ENTITY_PATHS = (
     "world/robot",
     "world/robot/trail",
@@ -52,7 +56,7 @@ class EpisodeRecorder:
         self._tmp = None
         if spawn:
             try:
-                self.rec.spawn(connect=True)
+                self._spawn_viewer()
             except Exception as exc:  # no viewer installed or no display: keep recording to the file
                 import warnings
 
@@ -65,6 +69,16 @@ class EpisodeRecorder:
         self._episode_start = 0.0
         self._robot_trail: list = []
         self._person_trail: list = []
+
+    def _spawn_viewer(self, port: int = VIEWER_PORT) -> None:
+        """Start a rerun viewer that listens on the loopback address only (``rerun`` binds
+        0.0.0.0 by default, and the SDK's own spawn cannot change that), then stream to it."""
+        exe = shutil.which("rerun") or str(Path(sys.executable).with_name("rerun"))
+        if not Path(exe).exists():
+            raise FileNotFoundError("no rerun viewer executable found")
+        subprocess.Popen([exe, "--bind", "127.0.0.1", "--port", str(port)], stdin=subprocess.DEVNULL,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        self.rec.connect_grpc(f"rerun+http://127.0.0.1:{port}/proxy")
 
     def begin_episode(self, name: str, index: int = 0) -> None:
         self._robot_trail, self._person_trail = [], []

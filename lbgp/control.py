@@ -52,8 +52,9 @@ class GoalController:
     """LBGP/HC: the action is a goal in the person frame; the TEB planner drives there.
 
     The goal stays fixed in the person frame while the person walks, so it is re-expressed in the
-    world at every planner call, heading along the person's heading, and moves with the person's
-    velocity: the band ends where the goal will be when the robot arrives.
+    world at every planner call, heading along the person's heading, and the planner predicts it
+    along the person's predicted arc (velocity and turn rate): every band pose tracks where the goal
+    will be at that pose's time, also while the person turns.
     """
 
     kind = "goal"
@@ -77,6 +78,6 @@ class GoalController:
         goal = from_frame(np.array([self.goal_person[0], self.goal_person[1], 0.0]), state.person_pose)
         plan = self.planner.plan(
             state.robot_pose, state.robot_velocity, goal, state.person_pose, state.person_velocity,
-            goal_velocity=state.person_velocity,
+            person_turn_rate=state.person_turn_rate, goal_moves_with_person=True,
         )
         return Command(plan.v, plan.w, plan.status, goal, plan)

@@ -20,6 +20,7 @@ class WorldState:
     robot_velocity: np.ndarray  # (v, w): body forward speed m/s, yaw rate rad/s
     person_pose: np.ndarray  # (x, y, yaw) world
     person_velocity: np.ndarray  # (vx, vy) world, m/s (estimated from poses)
+    person_turn_rate: float = 0.0  # rad/s (estimated from poses, like the velocity)
 
     @property
     def distance_alpha(self) -> tuple[float, float]:

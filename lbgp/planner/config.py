@@ -30,11 +30,12 @@ class PlannerConfig:
     band_dt: float = 0.1  # s between band poses (= the control period: the first segment is the command)
     # objective weights (least squares; units m, rad, m/s, rad/s)
     weight_track: float = 1.0  # every pose: squared distance from the moving goal at that pose's time
+    weight_track_start: float = 0.1  # share of weight_track on the first pose, rising linearly to 1 at the last
     weight_goal: float = 4.0  # extra on the last pose's goal distance
     weight_goal_heading: float = 0.5  # last pose's heading vs the goal's
     weight_acc: float = 0.05  # squared change of v between segments (and from the current v)
-    weight_alpha: float = 0.02  # squared change of w between segments (and from the current w)
-    weight_turn: float = 0.01  # squared w
+    weight_alpha: float = 0.1  # squared change of w between segments (and from the current w)
+    weight_turn: float = 0.05  # squared w
     weight_clearance_slack: float = 10.0  # quadratic penalty of a clearance violation (m)
     weight_clearance_l1: float = 100.0  # exact (L1) penalty of a clearance violation (m)
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
@@ -48,6 +49,7 @@ class PlannerConfig:
     step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this,
     cost_tolerance: float = 0.0  # or when the objective falls by less than this share in an iteration
     turn_around_candidate: bool = True  # also solve a band that turns to face a goal behind the robot
+    turn_around_distance: float = 0.5  # m the goal must still be behind the robot at the band's end for that
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
     wait_margin: float = 0.3  # m beyond the safety distance that counts as near
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)

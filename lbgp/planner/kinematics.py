@@ -54,26 +54,25 @@ def position_jacobian(poses: np.ndarray, w: np.ndarray, h: float, lower: np.ndar
     return Jx, Jy
 
 
-def pursuit_commands(pose0, v_start: float, w_start: float, goal_xy, goal_vel, h: float, first_period: float,
+def pursuit_commands(pose0, v_start: float, w_start: float, goal_path, goal_vel, h: float, first_period: float,
                      M: int, limits, reverse: bool, wait: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """A deterministic first guess for the band: a simple pursuit of the moving goal, rolled out
     for M segments within the velocity and acceleration limits.
 
-    The robot steers towards where the goal will be at the end of each segment and matches the
-    goal's velocity plus a proportional correction along its heading. With ``reverse`` it faces
+    The robot steers towards where the goal will be at the end of each segment (``goal_path``,
+    (M, 2)) and matches the goal's current velocity ``goal_vel`` plus a proportional correction
+    along its heading. With ``reverse`` it faces
     the goal with whichever end is closer (the goal behind it is reached by slowing or reversing);
     without, it turns its front towards the goal (a goal behind it means turning around). With
     ``wait`` it brakes to a stop while steering (to let a person cross in front of it first).
     """
     x, y, th = float(pose0[0]), float(pose0[1]), float(pose0[2])
-    gx, gy = float(goal_xy[0]), float(goal_xy[1])
     gvx, gvy = float(goal_vel[0]), float(goal_vel[1])
     v_prev, w_prev = v_start, w_start
     vs, ws = np.empty(M), np.empty(M)
     tau_v, tau_w, look = 0.6, 0.35, 1.0  # s: time constants and look-ahead (only shape the first guess)
     for k in range(M):
-        t = (k + 1) * h
-        rx, ry = gx + gvx * t - x, gy + gvy * t - y
+        rx, ry = float(goal_path[k, 0]) - x, float(goal_path[k, 1]) - y
         c, s = math.cos(th), math.sin(th)
         # steer towards where the goal will be ``look`` s later: well defined even on the goal
         ax, ay = rx + gvx * look, ry + gvy * look

@@ -7,13 +7,14 @@ where the robot will be at t_i = i h. The band is parameterised by the M = N - 1
 velocity limits are bounds and acceleration limits are linear constraints, both exact.
 
 Objective (least squares, SI units): every pose i tracks the goal's *predicted* position at its
-own time, g(t_i) = goal + goal_velocity * t_i (a goal carried by a walking person is a moving
-target: a goal slightly behind the robot is met by slowing down, never by looping back to where
-it was), with extra weight on the last pose and on its heading; small costs on changes of v and w
+own time g(t_i): a goal carried by a walking person rides the person's predicted arc (velocity and
+turn rate), a free goal moves at its own velocity (a goal slightly behind the robot is met by
+slowing down, never by looping back to where it was), with extra weight on the last pose and on
+its heading; small costs on changes of v and w
 (smooth commands) and on w. Constraints: velocity and acceleration limits (the first segment from
 the robot's current velocity over one control period), a trust region per SQP iteration, and a
 clearance of at least the safety distance from the person's predicted position (constant
-velocity) at every pose's time, linearised as half-planes, elastic (slack with an exact L1 plus a
+velocity and turn rate) at every pose's time, linearised as half-planes, elastic (slack with an exact L1 plus a
 quadratic penalty) so that the QP is always feasible.
 
 Sequential QP (Gauss-Newton): each iteration rolls the commands out, linearises, and solves one QP
@@ -100,6 +101,20 @@ def safe_stop(v_now: float, w_now: float, cfg: PlannerConfig) -> tuple[float, fl
     return clamp_command(v, w, v_now, w_now, cfg)
 
 
+def predict_person(xy, velocity, turn_rate: float, times: np.ndarray):
+    """The person's positions at ``times`` on a constant-turn arc (velocity vector rotating at
+    ``turn_rate``), and how far the person has turned by then (rad)."""
+    rotation = turn_rate * times
+    if abs(turn_rate) < 1e-6:
+        return xy[None, :] + times[:, None] * velocity[None, :], rotation
+    # integral of R(w s) v ds = (1/w) [[sin wt, cos wt - 1], [1 - cos wt, sin wt]] v
+    s_, c1 = np.sin(rotation), np.cos(rotation) - 1.0
+    vx, vy = velocity
+    dx = (s_ * vx + c1 * vy) / turn_rate
+    dy = (-c1 * vx + s_ * vy) / turn_rate
+    return xy[None, :] + np.stack([dx, dy], axis=1), rotation
+
+
 @dataclasses.dataclass
 class _Problem:
     """Everything one call's QPs share (world frame)."""
@@ -132,13 +147,16 @@ class TebPlanner:
         """Drop OSQP's warm start (plans never depended on it beyond the solver's tolerance)."""
         self._solver = None
 
-    def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0)) -> Plan:
+    def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0),
+             person_turn_rate: float = 0.0, goal_moves_with_person: bool = False) -> Plan:
         """One planner call.
 
         ``goal`` is (x, y) or (x, y, yaw) in the world now; its yaw defaults to the person's
-        heading. ``person_velocity`` is the person's world (vx, vy). ``goal_velocity`` is the goal's
-        world (vx, vy): a goal carried along by a walking person moves with it, and every band pose
-        tracks where the goal will be at that pose's time ((0, 0): a fixed goal, stop there).
+        heading. The person is predicted on a constant-turn arc: world velocity ``person_velocity``
+        (vx, vy) turning at ``person_turn_rate`` (rad/s). Every band pose tracks where the goal will
+        be at that pose's time: with ``goal_moves_with_person`` the goal is fixed in the person's
+        frame and rides the person's arc (what a follow-ahead goal does); otherwise it moves at
+        ``goal_velocity`` ((0, 0): a fixed goal, stop there).
         Never raises on bad numbers: returns a safe-stop plan whose status says why.
         """
         t_start = time.perf_counter()
@@ -153,22 +171,32 @@ class TebPlanner:
                 goal = np.array([goal[0], goal[1], person_pose[2]])
             goal = goal.reshape(3)
             goal_vel = np.asarray(goal_velocity, dtype=float).reshape(2)
+            turn = float(person_turn_rate)
         except (TypeError, ValueError):
             return self._stop(0.0, 0.0, INVALID_INPUT, t_start)
-        values = np.concatenate([robot_pose, [v_now, w_now], goal_vel, person_pose, person_vel, goal])
+        values = np.concatenate([robot_pose, [v_now, w_now, turn], goal_vel, person_pose, person_vel, goal])
         if not np.all(np.isfinite(values)):
             return self._stop(v_now, w_now, INVALID_INPUT, t_start)
         if np.linalg.norm(goal[:2] - person_pose[:2]) < cfg.safety_distance:
             return self._stop(v_now, w_now, GOAL_IN_COLLISION, t_start)
 
-        times = self._times[1:]
+        person_path, rotation = predict_person(person_pose[:2], person_vel, turn, self._times)
+        if goal_moves_with_person:
+            offset = goal[:2] - person_pose[:2]
+            c, s_ = np.cos(rotation[1:]), np.sin(rotation[1:])
+            goal_path = person_path[1:] + np.stack([c * offset[0] - s_ * offset[1], s_ * offset[0] + c * offset[1]], axis=1)
+            goal_vel = person_vel + turn * np.array([-offset[1], offset[0]])  # the goal's velocity now
+            goal_yaw = float(goal[2] + rotation[-1])
+        else:
+            goal_path = goal[None, :2] + self._times[1:, None] * goal_vel[None, :]
+            goal_yaw = float(goal[2])
         problem = _Problem(
             pose0=robot_pose,
             v_ref=min(max(v_now, -cfg.max_vel_x_backwards), cfg.max_vel_x),
             w_ref=min(max(w_now, -cfg.max_vel_theta), cfg.max_vel_theta),
-            goal_path=goal[None, :2] + times[:, None] * goal_vel[None, :],
-            goal_yaw=float(goal[2]),
-            person_path=person_pose[None, :2] + self._times[:, None] * person_vel[None, :],
+            goal_path=goal_path,
+            goal_yaw=goal_yaw,
+            person_path=person_path,
         )
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_behind(problem):
@@ -178,7 +206,7 @@ class TebPlanner:
             name = candidates.pop(0)
             if name != "keep" and self._over_budget(t_start, iterations):
                 break
-            v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, goal[:2], goal_vel, self.h,
+            v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations)
             iterations += done
@@ -200,10 +228,12 @@ class TebPlanner:
 
     # ------------------------------------------------------------------ helpers
     def _goal_behind(self, problem: _Problem) -> bool:
-        """Whether the goal, half way through the band's horizon, lies behind the robot."""
+        """Whether the goal, at the end of the band's horizon, will still lie more than
+        ``turn_around_distance`` behind the robot's current pose: only then can turning around pay
+        (a moving goal that will have caught up is met by slowing down or waiting)."""
         x, y, th = problem.pose0
-        g = problem.goal_path[self.M // 2]
-        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < 0.0
+        g = problem.goal_path[-1]
+        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < -self.cfg.turn_around_distance
 
     def _near_person(self, problem: _Problem, u: np.ndarray) -> bool:
         """Whether the band driven by ``u`` comes within ``wait_margin`` of the safety distance."""
@@ -246,7 +276,9 @@ class TebPlanner:
         X, Y, TH, V, W, S = (j * M for j in range(6))
         k = np.arange(M)
         self._times = h * np.arange(self.N)
-        track = np.full(M, cfg.weight_track)
+        # tracking weight grows along the band (ramp from weight_track_start to weight_track): the
+        # robot is asked to be on the goal's path later, not at once, so it converges smoothly
+        track = cfg.weight_track * np.linspace(cfg.weight_track_start, 1.0, M)
         track[-1] += cfg.weight_goal
         self._w_track = np.concatenate([track, track])
         # constant residual rows on the commands: v changes, w changes, w (and the last heading,

@@ -125,12 +125,14 @@ class DeployLoop:
         self._was_within = False
 
     # ------------------------------------------------------------------ one tick
-    def _person_velocity(self, frame) -> np.ndarray:
-        """Finite difference over about one agent period of source time, as in simulation."""
+    def _person_motion(self, frame) -> tuple[np.ndarray, float]:
+        """Velocity and turn rate by finite difference over about one agent period of source time,
+        as in simulation."""
         target = frame.t - obs_lib.FRAME_PERIOD
         older = [(t, p) for t, p in self._people if t <= target + 1e-6]
         t0, p0 = older[-1] if older else self._people[0]
-        return obs_lib.estimate_person_velocity(p0, frame.person, frame.t - t0)
+        return (obs_lib.estimate_person_velocity(p0, frame.person, frame.t - t0),
+                obs_lib.estimate_person_turn_rate(p0, frame.person, frame.t - t0))
 
     def _stop_command(self) -> tuple[float, float]:
         """Towards zero at the emergency deceleration (limit -> 0 in ``stop_time``)."""
@@ -157,7 +159,7 @@ class DeployLoop:
             if distance < self.min_distance:
                 status = record.status = safety_lib.TOO_CLOSE
         if status == safety_lib.OK:
-            state = WorldState(frame.t, frame.robot.copy(), np.array(self.command), frame.person.copy(), self._person_velocity(frame))
+            state = WorldState(frame.t, frame.robot.copy(), np.array(self.command), frame.person.copy(), *self._person_motion(frame))
             if now - self._last_good > self.cfg.safety.reanchor_after:  # first data, or back after a long gap
                 self.stack.reset(state.robot_pose, state.person_pose)
                 self.controller.reset()

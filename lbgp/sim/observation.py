@@ -95,6 +95,13 @@ def unscale(obs: np.ndarray) -> np.ndarray:
     return (np.asarray(obs, dtype=float).reshape(-1, 3) / _INV_SCALE).ravel()
 
 
+def estimate_person_turn_rate(prev_pose, pose, dt: float) -> float:
+    """Person yaw rate (rad/s) by finite difference of two poses ``dt`` seconds apart."""
+    if dt <= 0:
+        return 0.0
+    return math.remainder(float(pose[2]) - float(prev_pose[2]), 2.0 * math.pi) / dt
+
+
 def estimate_person_velocity(prev_pose, pose, dt: float) -> np.ndarray:
     """Person world velocity (vx, vy) by finite difference of two poses ``dt`` seconds apart."""
     if dt <= 0:

@@ -268,7 +268,8 @@ class FollowAheadTask(control.Task):
     # -- world state (what the observation and the controller see)
     def world_state(self, physics: Physics) -> WorldState:
         person_velocity = obs_lib.estimate_person_velocity(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
-        return WorldState(self.time, physics.robot_pose(), physics.robot_velocity(), self.person_pose.copy(), person_velocity)
+        turn_rate = obs_lib.estimate_person_turn_rate(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
+        return WorldState(self.time, physics.robot_pose(), physics.robot_velocity(), self.person_pose.copy(), person_velocity, turn_rate)
 
     # -- stepping (called by lbgp.sim.env.FollowAheadEnv)
     def before_step(self, action, physics: Physics) -> None:

@@ -1,12 +1,18 @@
-"""Planner solve time per call along real simulated episodes, and the goal-driven env step rate.
+"""Planner solve time per call along real simulated episodes, QP accuracy, and the goal-driven env rate.
 
     python benchmarks/bench_planner.py --json results/bench_planner.json
 
 For each robot and band size (N = 20 and 30 poses): goal-driven episodes of the evaluation
-scenarios are run in MuJoCo with a scripted goal 1.5 m ahead of the person until 1,000 planner calls
-were made; each call's wall time is recorded (median, p99, max, and which share of the calls
-re-initialised the band). The env rate is agent steps per second of the goal-driven task (one
-process, two planner calls per agent step).
+scenarios are run in MuJoCo with a scripted goal 1.5 m ahead of the person until ``--calls``
+planner calls were made; each call's wall time is recorded (median, p99, max), with the OSQP
+iterations per QP, how often the iteration cap was hit, how often polishing failed (the solution
+is then accurate to ``osqp_eps`` only), the SQP iterations per call and which candidate bands won.
+
+Accuracy (N = 20): ``--accuracy`` QPs recorded along those episodes are solved again from scratch
+to a tight tolerance (eps 1e-9, polished); reported is how far the planner's returned step of the
+band's poses (metres) is from that reference: median, p99 and max.
+
+BLAS is pinned to one thread by lbgp itself (see lbgp/__init__.py).
 """
 
 from __future__ import annotations
@@ -17,6 +23,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+import osqp
+import scipy.sparse as sp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
@@ -26,51 +34,90 @@ from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.sim import make_env, scenario_names  # noqa: E402
 
 
-def bench(robot: str, n_poses: int, calls: int) -> dict:
+def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0) -> dict:
     cfg = planner_config_for(robot).with_(n_poses=n_poses)
-    times, statuses = [], []
+    times, statuses, iterations, candidates, recorded = [], [], [], [], []
     action = action_from_goal([1.5, 0.0])
     steps, t_env = 0, 0.0
     scenarios = scenario_names()
+    totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "unpolished": 0}
     i = 0
     while len(times) < calls:
         env = make_env(scenarios[i % len(scenarios)], robot=robot, seed=i, planner_config=cfg)
         planner = env.task.controller.planner
-        original = planner.plan
+        original_plan, original_step = planner.plan, planner._sqp_step
 
         def timed(*a, **kw):
             t0 = time.perf_counter()
-            plan = original(*a, **kw)
+            plan = original_plan(*a, **kw)
             times.append(time.perf_counter() - t0)
             statuses.append(plan.status)
+            iterations.append(plan.iterations)
+            candidates.append(plan.candidate)
             return plan
 
+        def recording_step(problem, u, *rest):
+            step, status = original_step(problem, u, *rest)
+            if step is not None and len(recorded) < accuracy and len(times) % 7 == 0:
+                p = planner
+                recorded.append((sp.csc_matrix((p._Px, *p._P_struct), shape=(p.n, p.n)), p._q.copy(),
+                                 sp.csc_matrix((p._A[p._A_at], *p._A_struct), shape=(p.m, p.n)), p._lo.copy(),
+                                 p._hi.copy(), np.asarray(p._solver_x[: 2 * p.M]).copy()))
+            return step, status
+
         planner.plan = timed
+        if accuracy:
+            planner._sqp_step = recording_step
         ts = env.reset()
         t0 = time.perf_counter()
         while not ts.last() and len(times) < calls:
             ts = env.step(action)
             steps += 1
         t_env += time.perf_counter() - t0
+        for k in totals:
+            totals[k] += planner.stats[k]
         i += 1
     ms = np.array(times[:calls]) * 1000.0
-    return {
+    result = {
         "calls": int(len(ms)),
         "median_ms": float(np.median(ms)),
         "p99_ms": float(np.percentile(ms, 99)),
         "max_ms": float(ms.max()),
         "status_counts": {s: statuses.count(s) for s in sorted(set(statuses))},
+        "candidate_counts": {c or "none": candidates.count(c) for c in sorted(set(candidates))},
+        "sqp_iterations_per_call": float(np.mean(iterations)),
+        "qp_solves": totals["solves"],
+        "osqp_iterations_per_qp": totals["osqp_iterations"] / max(totals["solves"], 1),
+        "osqp_iteration_cap_hits": totals["max_iter_hits"],
+        "unpolished_qps": totals["unpolished"],
         "goal_env_steps_per_s": steps / t_env,
     }
+    if accuracy:
+        result["accuracy_vs_tight_reference_m"] = qp_accuracy(recorded)
+    return result
+
+
+def qp_accuracy(recorded) -> dict:
+    """Pose-step error (m) of the planner's QP solutions against tightly solved references."""
+    errors = []
+    for P, q, A, lo, hi, x_planner in recorded:
+        solver = osqp.OSQP()
+        solver.setup(P, q, A, lo, hi, verbose=False, eps_abs=1e-9, eps_rel=1e-9, max_iter=200_000, polishing=True)
+        reference = solver.solve(raise_error=False).x
+        errors.append(float(np.max(np.abs(np.asarray(reference[: len(x_planner)]) - x_planner))))
+    e = np.array(errors)
+    return {"qps": int(len(e)), "median": float(np.median(e)), "p99": float(np.percentile(e, 99)), "max": float(e.max())}
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", required=True)
     parser.add_argument("--calls", type=int, default=1000)
+    parser.add_argument("--accuracy", type=int, default=200, help="QPs checked against a tight reference (N = 20)")
     args = parser.parse_args()
     result = {
-        f"{robot}_N{n}": bench(robot, n, args.calls) for robot in ("jackal", "turtlebot2") for n in (20, 30)
+        f"{robot}_N{n}": bench(robot, n, args.calls, args.accuracy if n == 20 else 0)
+        for robot in ("jackal", "turtlebot2") for n in (20, 30)
     }
     write_result(args.json, result)
 

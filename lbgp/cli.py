@@ -8,6 +8,7 @@ import os
 import sys
 from pathlib import Path
 
+from lbgp import cli_args as A
 from lbgp.policies import default_policy_path
 
 
@@ -144,7 +145,10 @@ def cmd_deploy(args) -> int:
         loop = deploy(policy, source=args.source, sink=args.sink, robot=args.robot, steps=args.steps, log=args.log,
                       record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
                       planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
-                      metadata={"method": args.method, "policy": args.policy or "default"})
+                      metadata={"method": args.method, "policy": args.policy or "default"},
+                      first_pose_timeout=args.first_pose_timeout or None,
+                      on_open=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True),
+                      on_wait=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True))
     except KeyboardInterrupt:  # before the loop ran (opening the source, the log, the viewer)
         print("interrupted before the loop started: no command was sent", file=sys.stderr)
         return 130
@@ -160,6 +164,10 @@ def cmd_deploy(args) -> int:
         _write_json_atomic(Path(args.json), summary)
     if loop.error is not None:
         print(f"lbgp deploy: error: {summary['error']} (a zero command was sent)", file=sys.stderr)
+        return 1
+    if loop.end_reason == "no_pose":
+        print(f"lbgp deploy: error: no valid pose from {args.source} within {args.first_pose_timeout:g} s "
+              f"(--first-pose-timeout); the robot was held stopped", file=sys.stderr)
         return 1
     if loop.end_reason == "interrupted":
         print("interrupted: a zero command was sent", file=sys.stderr)
@@ -219,7 +227,14 @@ def cmd_experiment(args) -> int:
 
 
 def _names(text: str) -> list[str]:
-    return [n.strip() for n in text.split(",") if n.strip()]
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError("needs at least one name")
+    return names
+
+
+def _seed_list(text: str) -> list[int]:
+    return [A.seed(x) for x in _names(text)]
 
 
 def cmd_plot_curves(args) -> int:
@@ -231,29 +246,29 @@ def cmd_plot_curves(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="lbgp", description="Learning Based Goal Planning: a robot that walks in front of a person.")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    parser = A.OneLineParser(prog="lbgp", description="Learning Based Goal Planning: a robot that walks in front of a person.")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, parser_class=A.OneLineParser)
 
     p = sub.add_parser("demo", help="run one seeded episode per curriculum level, write a rerun recording and a summary")
     p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", default="demo_out", help="output folder (default: demo_out)")
-    p.add_argument("--policy", help="policy file (default: the shipped pretrained LBGP policy for the Jackal)")
+    p.add_argument("--seed", type=A.seed, default=0)
+    p.add_argument("--out", type=A.output_dir, default="demo_out", help="output folder (default: demo_out)")
+    p.add_argument("--policy", type=A.input_file, help="policy file (default: the shipped pretrained LBGP policy for the Jackal)")
     p.add_argument("--scripted", action="store_true", help="use the scripted goal 1.5 m ahead instead of a policy")
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("evaluate", help="seeded episodes of a method on levels or scenarios; metrics table and JSON")
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])
-    p.add_argument("--policy", help="policy file (default: the shipped pretrained one for the method)")
-    p.add_argument("--hc-distance", type=float, default=None, help="HC: goal distance ahead of the predicted person (m, default 1.5)")
-    p.add_argument("--hc-horizon", type=float, default=None, help="HC: EKF prediction horizon (s, default 0: the planner predicts the goal)")
+    p.add_argument("--policy", type=A.input_file, help="policy file (default: the shipped pretrained one for the method)")
+    p.add_argument("--hc-distance", type=A.distance, default=None, help="HC: goal distance ahead of the predicted person (m, default 1.5)")
+    p.add_argument("--hc-horizon", type=A.nonnegative_float, default=None, help="HC: EKF prediction horizon (s, default 0: the planner predicts the goal)")
     p.add_argument("--scenario", default="all", help="all (paper scenarios), levels, or comma-separated names")
     p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
-    p.add_argument("--episodes", type=int, default=10)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--person-path", help="CSV of x,y waypoints for the person (replaces the scenario's motion)")
-    p.add_argument("--json", help="write the metrics here")
-    p.add_argument("--record", help="write a rerun recording (.rrd) of every episode")
+    p.add_argument("--episodes", type=A.positive_int, default=10)
+    p.add_argument("--seed", type=A.seed, default=0)
+    p.add_argument("--person-path", type=A.input_file, help="CSV of x,y waypoints for the person (replaces the scenario's motion)")
+    p.add_argument("--json", type=A.output_file, help="write the metrics here")
+    p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd) of every episode")
     p.add_argument("--spawn", action="store_true", help="also open a live rerun viewer (when one is installed)")
     p.set_defaults(func=cmd_evaluate)
 
@@ -261,16 +276,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e"])
     p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
     p.add_argument("--no-curriculum", action="store_true", help="train on the final level from the start")
-    p.add_argument("--steps", type=int, default=None, help="environment steps in all (default 300000)")
-    p.add_argument("--minutes", type=float, default=None, help="also stop after this much wall time")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--actors", type=int, default=4, help="actor processes (one of them exploits)")
-    p.add_argument("--prior-weight", type=float, default=None,
+    p.add_argument("--steps", type=A.positive_int, default=None, help="environment steps in all (default 300000)")
+    p.add_argument("--minutes", type=A.positive_float, default=None, help="also stop after this much wall time")
+    p.add_argument("--seed", type=A.seed, default=0)
+    p.add_argument("--actors", type=A.positive_int, default=4, help="actor processes (one of them exploits)")
+    p.add_argument("--prior-weight", type=A.nonnegative_float, default=None,
                    help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; 0: plain D4PG)")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],
                    help="processes: actor processes (default); inline: one process, reproducible; ray: Ray tasks (extra)")
-    p.add_argument("--out", help="run directory (created)")
-    p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its last checkpoint")
+    p.add_argument("--out", type=A.output_dir, help="run directory (created)")
+    p.add_argument("--resume", type=A.existing_dir, metavar="DIR", help="continue the run in DIR from its last checkpoint")
     p.set_defaults(func=cmd_train)
 
     p = sub.add_parser("experiment", help="the paper's experiments: sim table, real-world protocol in sim, ablation")
@@ -280,54 +295,56 @@ def build_parser() -> argparse.ArgumentParser:
                                               "simulated mocap -> results/real_protocol_table.md + .csv"),
                             ("ablation", "train LBGP, LBGP-no-curriculum and E2E over seeds -> results/ablation_curves.png")):
         q = exp.add_parser(name, help=help_text)
-        q.add_argument("--out", default="results", help="output folder (default: results)")
-        q.add_argument("--seed", type=int, default=0)
-        q.add_argument("--lbgp-policy", help="LBGP policy file (default: the shipped one)")
-        q.add_argument("--e2e-policy", help="E2E policy file (default: the shipped one)")
+        q.add_argument("--out", type=A.output_dir, default="results", help="output folder (default: results)")
+        q.add_argument("--seed", type=A.seed, default=0)
+        q.add_argument("--lbgp-policy", type=A.input_file, help="LBGP policy file (default: the shipped one)")
+        q.add_argument("--e2e-policy", type=A.input_file, help="E2E policy file (default: the shipped one)")
         if name == "sim":
-            q.add_argument("--episodes", type=int, default=5, help="seeded episodes per scenario and method")
-            q.add_argument("--horizon", type=int, default=35, help="agent steps per episode")
+            q.add_argument("--episodes", type=A.positive_int, default=5, help="seeded episodes per scenario and method")
+            q.add_argument("--horizon", type=A.positive_int, default=35, help="agent steps per episode")
             q.add_argument("--scenarios", type=_names, help="comma-separated subset of the 9 scenarios")
         if name == "real-protocol":
             q.add_argument("--robot", default="turtlebot2", choices=["turtlebot2", "jackal"])
-            q.add_argument("--steps", type=int, default=60, help="agent steps per setting (constant, as in the paper)")
-            q.add_argument("--repeats", type=int, default=1, help="runs per setting (different mocap noise)")
+            q.add_argument("--steps", type=A.positive_int, default=60, help="agent steps per setting (constant, as in the paper)")
+            q.add_argument("--repeats", type=A.positive_int, default=1, help="runs per setting (different mocap noise)")
             q.add_argument("--paths", type=_names, help="comma-separated subset of straight,s_shape,u_turn")
         if name == "ablation":
-            q.add_argument("--minutes", type=float, default=10.0, help="wall-time budget per training run")
-            q.add_argument("--seeds", type=lambda t: [int(x) for x in _names(t)], default=[0, 1], help="comma-separated seeds")
-            q.add_argument("--max-steps", type=int, help="also stop each run after this many env steps")
+            q.add_argument("--minutes", type=A.positive_float, default=10.0, help="wall-time budget per training run")
+            q.add_argument("--seeds", type=_seed_list, default=[0, 1], help="comma-separated seeds")
+            q.add_argument("--max-steps", type=A.positive_int, help="also stop each run after this many env steps")
             q.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"])
-            q.add_argument("--runs-dir", help="where the training runs go (default: OUT/ablation_runs)")
+            q.add_argument("--runs-dir", type=A.output_dir, help="where the training runs go (default: OUT/ablation_runs)")
         q.set_defaults(func=cmd_experiment)
 
     p = sub.add_parser("deploy", help="run a policy on a robot (or the simulated one): poses in, commands out")
     p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e", "hc", "scripted"])
-    p.add_argument("--policy", help="policy file (default: the shipped pretrained Jackal policy of the method)")
+    p.add_argument("--policy", type=A.input_file, help="policy file (default: the shipped pretrained Jackal policy of the method)")
     p.add_argument("--source", default="sim", help="vicon://HOST, optitrack://HOST, udp://[HOST:]PORT[?from=IP], mcap://FILE or sim[://SCENARIO]")
     p.add_argument("--sink", help="udp://HOST:PORT, ros2[:///TOPIC], sim or none (default: sim for a sim source, else none)")
     p.add_argument("--robot", default="turtlebot2", choices=["jackal", "turtlebot2"])
-    p.add_argument("--steps", type=int, help="agent steps (0.2 s) to run; default: until Ctrl-C or the source ends")
-    p.add_argument("--seed", type=int, default=0, help="sim source: seed")
-    p.add_argument("--person-path", help="sim source: CSV of x,y waypoints for the person")
-    p.add_argument("--log", help="write an MCAP log (ROS 2 schemas, opens in Foxglove)")
-    p.add_argument("--record", help="write a rerun recording (.rrd)")
+    p.add_argument("--steps", type=A.positive_int, help="agent steps (0.2 s) to run; default: until Ctrl-C or the source ends")
+    p.add_argument("--seed", type=A.seed, default=0, help="sim source: seed")
+    p.add_argument("--person-path", type=A.input_file, help="sim source: CSV of x,y waypoints for the person")
+    p.add_argument("--log", type=A.output_file, help="write an MCAP log (ROS 2 schemas, opens in Foxglove)")
+    p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd)")
     p.add_argument("--spawn", action="store_true", help="open a live rerun viewer")
-    p.add_argument("--planner-budget-ms", type=float, default=2.0,
+    p.add_argument("--planner-budget-ms", type=A.nonnegative_float, default=2.0,
                    help="anytime SQP budget per planner call (default 2 ms, keeps pose-to-command latency p99 under 5 ms; 0: "
                         "fixed iteration counts as in simulation)")
-    p.add_argument("--json", help="write the run's summary here")
+    p.add_argument("--first-pose-timeout", type=A.nonnegative_float, default=10.0, metavar="S",
+                   help="end with an error if no valid pose arrived within S seconds (default 10; 0: wait for ever)")
+    p.add_argument("--json", type=A.output_file, help="write the run's summary here")
     p.set_defaults(func=cmd_deploy)
 
     p = sub.add_parser("replay", help="re-play an lbgp MCAP log: metrics and a rerun recording")
-    p.add_argument("log", help="the .mcap file written by lbgp deploy --log")
-    p.add_argument("--record", help="write a rerun recording (.rrd)")
-    p.add_argument("--json", help="write the metrics here")
+    p.add_argument("log", type=A.input_file, help="the .mcap file written by lbgp deploy --log")
+    p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd)")
+    p.add_argument("--json", type=A.output_file, help="write the metrics here")
     p.set_defaults(func=cmd_replay)
 
     p = sub.add_parser("plot-curves", help="learning curves of runs (mean and half-std band over seeds)")
-    p.add_argument("run_dirs", nargs="+", help="run directories; runs with the same label are averaged")
-    p.add_argument("--out", required=True, help="output image (.png)")
+    p.add_argument("run_dirs", nargs="+", type=A.existing_dir, help="run directories; runs with the same label are averaged")
+    p.add_argument("--out", type=A.output_file, required=True, help="output image (.png)")
     p.add_argument("--labels", nargs="*", help="one label per run dir (default: method + curriculum from config)")
     p.set_defaults(func=cmd_plot_curves)
     return parser

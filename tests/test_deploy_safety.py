@@ -354,3 +354,26 @@ def test_a_failed_atomic_save_leaves_no_temporary_file(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         save_atomic({"a": 1}, tmp_path / "checkpoint.pt")
     assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------- a deploy never waits silently
+def test_deploy_says_what_it_waits_for_and_gives_up_after_the_first_pose_timeout(tmp_path):
+    port = free_port()
+    robot = UdpCommandListener(("127.0.0.1", 0))
+    out = tmp_path / "s.json"
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "lbgp.cli", "deploy", "--method", "scripted", "--source", f"udp://127.0.0.1:{port}",
+             "--sink", f"udp://127.0.0.1:{robot.address[1]}", "--first-pose-timeout", "2.5", "--json", str(out)],
+            capture_output=True, text=True, timeout=60)
+        received, deadline = [], time.monotonic() + 1.0
+        while time.monotonic() < deadline:
+            received += robot.poll(timeout=0.05)
+    finally:
+        robot.close()
+    assert proc.returncode == 1
+    assert f"listening for poses on udp://127.0.0.1:{port}" in proc.stderr
+    assert proc.stderr.count("waiting for the first valid pose") >= 2  # once a second
+    assert "no valid pose from" in proc.stderr and "Traceback" not in proc.stderr
+    assert json.loads(out.read_text())["end"] == "no_pose"
+    assert received and all(v == 0.0 and w == 0.0 for _, v, w, _ in received)  # held stopped throughout

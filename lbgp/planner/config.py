@@ -48,8 +48,8 @@ class PlannerConfig:
     trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
     step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this,
     cost_tolerance: float = 0.0  # or when the objective falls by less than this share in an iteration
-    turn_around_candidate: bool = True  # also solve a band that turns to face a goal behind the robot
-    turn_around_distance: float = 0.5  # m the goal must still be behind the robot at the band's end for that
+    turn_around_candidate: bool = True  # turn to face a goal behind the robot when that is faster than backing up
+    weight_time_to_go: float = 2.0  # per s: candidate bands are compared with the time they leave to the goal
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
     wait_margin: float = 0.3  # m beyond the safety distance that counts as near
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)

@@ -81,6 +81,8 @@ def pursuit_commands(pose0, v_start: float, w_start: float, goal_path, goal_vel,
         if reverse and abs(e) > 0.5 * math.pi:
             e = e - math.copysign(math.pi, e)
         v_des = 0.0 if wait else (gvx * c + gvy * s) + (rx * c + ry * s) / tau_v
+        if not reverse:
+            v_des = max(v_des, 0.0)  # turning the front towards the goal: turn (on the spot), never back up
         w_des = e / tau_w * min(1.0, math.hypot(ax, ay) / 0.3)
         dt_acc = first_period if k == 0 else h
         dv, dw = limits.acc_lim_x * dt_acc, limits.acc_lim_theta * dt_acc

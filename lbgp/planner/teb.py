@@ -26,10 +26,11 @@ No hidden state: every call starts from the same deterministic first guess (a pu
 moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
 and velocity, person pose and velocity, goal) alone; OSQP's warm start (the previous QP's solution)
 only saves ADMM iterations: every QP is solved to ``osqp_eps`` and polished.
-Local minima (TEB's remedy: several bands in distinct topologies): when the goal lies behind the
-robot, a second band that turns the robot around is solved too; when the band passes near the
-person's predicted path, another that starts by braking (let the person cross first). The
-cheapest band is kept.
+Local minima (TEB's idea of bands in distinct topologies): for a goal that will still be behind
+the robot at the end of the horizon, the band's direction is chosen by comparing the time to turn
+around and drive there with the time to back up there (a forwards-only band when turning wins);
+when the band passes near the person's predicted path, a second band that starts by braking (let
+the person cross first) is solved too, and the cheaper of the two is kept.
 
 A goal within the person's safety distance, bad input, a failed QP, or a next pose that would go
 deeper into the person's safety radius returns a safe stop (decelerate within limits) with a
@@ -198,9 +199,7 @@ class TebPlanner:
             goal_yaw=goal_yaw,
             person_path=person_path,
         )
-        candidates = ["keep"]
-        if cfg.turn_around_candidate and self._goal_behind(problem):
-            candidates.append("turn")
+        candidates = ["turn" if cfg.turn_around_candidate and self._turning_around_is_faster(problem) else "keep"]
         best, iterations = None, 0
         while candidates:
             name = candidates.pop(0)
@@ -208,14 +207,17 @@ class TebPlanner:
                 break
             v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
-            u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations)
+            lower = self._forward_only(problem) if name == "turn" else self._u_lo  # turning around: forwards only
+            u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations, lower)
             iterations += done
             if status != OK:
+                if best is not None:
+                    continue  # an extra candidate that failed is just not a candidate
                 return self._stop(v_now, w_now, status, t_start, None, problem, iterations)
-            cost = self._cost(problem, u)
+            cost = self._cost(problem, u) + self._cost_to_go(problem, u)
             if best is None or cost < best[0] - 1e-9:
                 best = (cost, u, name)
-            if name == "keep" and cfg.wait_candidate and self._near_person(problem, u):
+            if name != "wait" and cfg.wait_candidate and self._near_person(problem, u):
                 candidates.append("wait")  # the person's path is near this band: also try letting them pass
         _, u, name = best
         poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
@@ -227,13 +229,35 @@ class TebPlanner:
         return self._result(v, w, OK, poses, problem, iterations, t_start, name)
 
     # ------------------------------------------------------------------ helpers
-    def _goal_behind(self, problem: _Problem) -> bool:
-        """Whether the goal, at the end of the band's horizon, will still lie more than
-        ``turn_around_distance`` behind the robot's current pose: only then can turning around pay
-        (a moving goal that will have caught up is met by slowing down or waiting)."""
+    def _turning_around_is_faster(self, problem: _Problem) -> bool:
+        """Whether to turn the robot's front towards a goal behind it rather than back up to it.
+
+        Where the goal will be at the end of the horizon (a moving goal that will have caught up
+        is met by slowing down or waiting, never by turning): if that is behind the robot, compare
+        the time to turn the front towards it and drive there with the time to turn the back
+        towards it and reverse there (turn at ``max_vel_theta``, drive at the speed limit). The
+        rule only picks the first guess and the band's direction; the decision moves away from the
+        boundary as the robot executes it (no chattering between the two)."""
+        cfg = self.cfg
         x, y, th = problem.pose0
         g = problem.goal_path[-1]
-        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < -self.cfg.turn_around_distance
+        dx, dy = g[0] - x, g[1] - y
+        bearing = math.remainder(math.atan2(dy, dx) - th, 2.0 * math.pi)
+        if abs(bearing) <= 0.5 * math.pi:
+            return False
+        distance = math.hypot(dx, dy)
+        forwards = abs(bearing) / cfg.max_vel_theta + distance / cfg.max_vel_x
+        backwards = (math.pi - abs(bearing)) / cfg.max_vel_theta + distance / max(cfg.max_vel_x_backwards, 1e-3)
+        return forwards < backwards
+
+    def _forward_only(self, problem: _Problem) -> np.ndarray:
+        """Command lower bounds of a forwards-only band: v >= 0 from the moment the robot can have
+        braked to 0 (a robot that is backing up now cannot stop at once)."""
+        cfg, M = self.cfg, self.M
+        lower = self._u_lo_forward.copy()
+        reachable = problem.v_ref + cfg.acc_lim_x * (cfg.control_period + self.h * np.arange(M))
+        lower[:M] = np.minimum(0.0, reachable)
+        return lower
 
     def _near_person(self, problem: _Problem, u: np.ndarray) -> bool:
         """Whether the band driven by ``u`` comes within ``wait_margin`` of the safety distance."""
@@ -329,6 +353,7 @@ class TebPlanner:
         self._hi[5 * M : 6 * M] = np.inf
         self._hi[8 * M :] = np.inf
         self._u_lo = np.concatenate([np.full(M, -cfg.max_vel_x_backwards), np.full(M, -cfg.max_vel_theta)])
+        self._u_lo_forward = np.concatenate([np.zeros(M), np.full(M, -cfg.max_vel_theta)])  # the "turn" band
         self._u_hi = np.concatenate([np.full(M, cfg.max_vel_x), np.full(M, cfg.max_vel_theta)])
         self._trust = np.concatenate([np.full(M, cfg.trust_region_v), np.full(M, cfg.trust_region_w)])
         self._acc_v = np.full(M, cfg.acc_lim_x * h)
@@ -353,22 +378,33 @@ class TebPlanner:
         return float(self._w_track @ track**2 + cfg.weight_goal_heading * heading**2 + self._w_const @ const**2
                      + cfg.weight_clearance_slack * violation @ violation + cfg.weight_clearance_l1 * violation.sum())
 
-    def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int):
+    def _cost_to_go(self, problem: _Problem, u: np.ndarray) -> float:
+        """What a band leaves undone, for comparing candidate bands beyond the horizon: the time to
+        cover the remaining distance to the goal at the speed the band's last pose allows towards
+        it (forwards if the goal is in front of it, backwards otherwise), times ``weight_time_to_go``."""
+        cfg = self.cfg
+        end = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)[-1]
+        d = problem.goal_path[-1] - end[:2]
+        ahead = math.cos(end[2]) * d[0] + math.sin(end[2]) * d[1]
+        speed = cfg.max_vel_x if ahead >= 0.0 else max(cfg.max_vel_x_backwards, 1e-3)
+        return cfg.weight_time_to_go * float(np.hypot(*d)) / speed
+
+    def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int, lower: np.ndarray):
         """SQP from the commands ``u``; returns (u, status, iterations). Converged when no command
         moves more than ``step_tolerance`` or the objective falls by less than ``cost_tolerance``
         (relative) in an iteration."""
         cfg, M = self.cfg, self.M
-        u = np.clip(u, self._u_lo, self._u_hi)
+        u = np.clip(u, lower, self._u_hi)
         cost = self._cost(problem, u)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
                 done -= 1
                 break
-            step, status = self._sqp_step(problem, u)
+            step, status = self._sqp_step(problem, u, lower)
             if status != OK:
                 return u, status, done
-            u = np.clip(u + step, self._u_lo, self._u_hi)
+            u = np.clip(u + step, lower, self._u_hi)
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
             previous, cost = cost, self._cost(problem, u)
@@ -376,7 +412,7 @@ class TebPlanner:
                 break
         return u, OK, done
 
-    def _sqp_step(self, problem: _Problem, u: np.ndarray):
+    def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray | None = None):
         cfg, M, h = self.cfg, self.M, self.h
         v, w = u[:M], u[M:]
         poses = rollout(problem.pose0, v, w, h)
@@ -399,7 +435,7 @@ class TebPlanner:
         q[3 * M - 1] = 2.0 * cfg.weight_goal_heading * heading
         q[3 * M : 5 * M] = 2.0 * self._Jc.T @ (self._w_const * const)
         lo, hi = self._lo, self._hi
-        lo[3 * M : 5 * M] = np.maximum(self._u_lo - u, -self._trust)
+        lo[3 * M : 5 * M] = np.maximum((self._u_lo if lower is None else lower) - u, -self._trust)
         hi[3 * M : 5 * M] = np.maximum(np.minimum(self._u_hi - u, self._trust), lo[3 * M : 5 * M])
         dv = np.diff(v, prepend=problem.v_ref)
         dw = np.diff(w, prepend=problem.w_ref)
@@ -422,6 +458,7 @@ class TebPlanner:
         else:
             self._solver.update(Ax=Ax, q=q, l=lo, u=hi)
         result = self._solver.solve(raise_error=False)
+        self._solver_x = result.x  # the whole QP solution (pose steps first), for benchmarks
         info = result.info
         self.stats["solves"] += 1
         self.stats["osqp_iterations"] += int(info.iter)

@@ -8,12 +8,20 @@ from lbgp.real.loop import DeployConfig, DeployLoop
 
 def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
            log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
-           end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None):
+           end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None,
+           first_pose_timeout: float | None = None, on_wait=None, on_open=None):
     """Run the loop until ``steps`` agent steps (or the source ends, Ctrl-C or a signal); returns the
     loop (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``; an exception raised
     while it ran is in ``loop.error``, after the zero command was sent and the log closed)."""
     pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance)
-    command_sink = open_sink(sink or ("sim" if world is not None else "none"), world=world)
+    if on_open is not None:
+        address = getattr(pose_source, "address", None)
+        on_open(f"listening for poses on udp://{address[0]}:{address[1]}" if address else f"reading poses from {source}")
+    try:
+        command_sink = open_sink(sink or ("sim" if world is not None else "none"), world=world)
+    except BaseException:
+        pose_source.close()
+        raise
     logger = recorder = None
     try:
         if log:
@@ -26,8 +34,9 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
             recorder = EpisodeRecorder(record, spawn=spawn_viewer)
         end_condition = (lambda: "contact" if world.contact else None) if world is not None else None
         loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance,
-                                                                                 planner_time_budget=planner_time_budget),
-                          logger=logger, recorder=recorder, end_condition=end_condition)
+                                                                                 planner_time_budget=planner_time_budget,
+                                                                                 first_pose_timeout=first_pose_timeout),
+                          logger=logger, recorder=recorder, end_condition=end_condition, on_wait=on_wait)
         loop.error = None
         try:
             loop.run()

@@ -73,6 +73,7 @@ class DeployConfig:
     max_duration: float | None = None  # s of loop clock before the loop ends (counts stopped time too)
     planner_time_budget: float | None = None  # s: anytime SQP budget per planner call (None: as in simulation)
     end_distance: float | None = None  # end the run when D exceeds this after having been within it (paper: 3 m)
+    first_pose_timeout: float | None = None  # s: end the run ("no_pose") if no valid pose arrived by then
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
 
 
@@ -98,7 +99,7 @@ class TickRecord:
 
 class DeployLoop:
     def __init__(self, source, sink, policy, config: DeployConfig | None = None, clock=None, logger=None,
-                 recorder=None, end_condition=None, keep_records: bool = True, name: str = "deploy"):
+                 recorder=None, end_condition=None, keep_records: bool = True, name: str = "deploy", on_wait=None):
         self.cfg = config or DeployConfig()
         self.source, self.sink, self.policy = source, sink, policy
         self.clock = clock or getattr(source, "clock", None) or WallClock()
@@ -123,6 +124,8 @@ class DeployLoop:
         self._last_agent_t = -math.inf
         self._last_good = -math.inf
         self._was_within = False
+        self.on_wait = on_wait  # optional callable(message): told once a second while no valid pose has arrived
+        self._next_wait_note = 0.0
 
     # ------------------------------------------------------------------ one tick
     def _person_motion(self, frame) -> tuple[np.ndarray, float]:
@@ -207,8 +210,28 @@ class DeployLoop:
         record.reward = reward
 
     # ------------------------------------------------------------------ the loop
+    def _waiting(self, record: TickRecord) -> str:
+        """While no valid pose has arrived: a note every second, and the first-pose timeout."""
+        if self._last_good > -math.inf:
+            return ""
+        waited = record.t - self._start_t
+        if self.on_wait is not None and waited >= self._next_wait_note:
+            self._next_wait_note = math.floor(waited) + 1.0
+            counts = ", ".join(f"{k} {v}" for k, v in self.monitor.counts.items() if v)
+            malformed = getattr(self.source, "malformed", 0) + getattr(self.source, "rejected_senders", 0)
+            self.on_wait(f"waiting for the first valid pose ({waited:.0f} s, status {record.status}"
+                         + (f", rejected frames: {counts}" if counts else "")
+                         + (f", dropped datagrams: {malformed}" if malformed else "") + "); the robot is held stopped")
+        timeout = self.cfg.first_pose_timeout
+        if timeout is not None and waited >= timeout - 1e-9:
+            return "no_pose"
+        return ""
+
     def _finished(self, record: TickRecord) -> str:
         cfg = self.cfg
+        waiting = self._waiting(record)
+        if waiting:
+            return waiting
         if cfg.max_steps is not None and self.agent_steps >= cfg.max_steps:
             return "steps"
         if cfg.max_duration is not None and record.t - self._start_t >= cfg.max_duration - 1e-9:
@@ -255,5 +278,5 @@ class DeployLoop:
                     self.logger.log_tick(TickRecord(self.clock.now(), SHUTDOWN, 0.0, 0.0))
                     self.logger.close()
         self.metrics.contact = self.end_reason == "contact"
-        self.metrics.terminated_early = self.end_reason not in ("steps", "duration", "source_ended", "")
+        self.metrics.terminated_early = self.end_reason not in ("steps", "duration", "source_ended", "", "no_pose")
         return self.metrics

@@ -33,6 +33,7 @@ class PlannerConfig:
     weight_track_start: float = 0.1  # share of weight_track on the first pose, rising linearly to 1 at the last
     weight_goal: float = 4.0  # extra on the last pose's goal distance
     weight_goal_heading: float = 0.5  # last pose's heading vs the goal's
+    weight_heading_track: float = 0.2  # every pose's heading vs the goal's at that time (ramped like the tracking)
     weight_acc: float = 0.05  # squared change of v between segments (and from the current v)
     weight_alpha: float = 0.1  # squared change of w between segments (and from the current w)
     weight_turn: float = 0.05  # squared w

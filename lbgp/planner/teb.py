@@ -124,7 +124,7 @@ class _Problem:
     v_ref: float
     w_ref: float
     goal_path: np.ndarray  # (M, 2) goal position at each pose's time
-    goal_yaw: float
+    goal_yaw: np.ndarray  # (M,) the goal's heading at each pose's time
     person_path: np.ndarray  # (N, 2) predicted person position at each pose's time, from now
 
 
@@ -187,10 +187,10 @@ class TebPlanner:
             c, s_ = np.cos(rotation[1:]), np.sin(rotation[1:])
             goal_path = person_path[1:] + np.stack([c * offset[0] - s_ * offset[1], s_ * offset[0] + c * offset[1]], axis=1)
             goal_vel = person_vel + turn * np.array([-offset[1], offset[0]])  # the goal's velocity now
-            goal_yaw = float(goal[2] + rotation[-1])
+            goal_yaw = goal[2] + rotation[1:]
         else:
             goal_path = goal[None, :2] + self._times[1:, None] * goal_vel[None, :]
-            goal_yaw = float(goal[2])
+            goal_yaw = np.full(self.M, goal[2])
         problem = _Problem(
             pose0=robot_pose,
             v_ref=min(max(v_now, -cfg.max_vel_x_backwards), cfg.max_vel_x),
@@ -317,7 +317,10 @@ class TebPlanner:
         P = np.zeros((n, n))
         P[X : X + M, X : X + M] = np.diag(2.0 * track)
         P[Y : Y + M, Y : Y + M] = np.diag(2.0 * track)
-        P[TH + M - 1, TH + M - 1] = 2.0 * cfg.weight_goal_heading
+        heading = cfg.weight_heading_track * np.linspace(cfg.weight_track_start, 1.0, M)
+        heading[-1] += cfg.weight_goal_heading
+        self._w_heading = heading
+        P[TH + np.arange(M), TH + np.arange(M)] = 2.0 * heading
         P[V : W + M, V : W + M] = 2.0 * Jc.T @ (self._w_const[:, None] * Jc)
         P[np.arange(S), np.arange(S)] += 2.0 * cfg.regularization
         P[S:, S:] += 2.0 * cfg.weight_clearance_slack * np.eye(M)
@@ -362,11 +365,11 @@ class TebPlanner:
         self._acc_w[0] = cfg.acc_lim_theta * cfg.control_period
 
     def _residuals(self, problem: _Problem, u: np.ndarray, poses: np.ndarray):
-        """Tracking residuals (2M,), the last heading's error, and the command residuals (3M,)."""
+        """Tracking residuals (2M,), heading errors (M,), and the command residuals (3M,)."""
         M = self.M
         track = (poses[1:, :2] - problem.goal_path).T.ravel()
         v, w = u[:M], u[M:]
-        heading = wrap_angle(float(poses[-1, 2]) - problem.goal_yaw)
+        heading = wrap_angle(poses[1:, 2] - problem.goal_yaw)
         return track, heading, np.concatenate([np.diff(v, prepend=problem.v_ref), np.diff(w, prepend=problem.w_ref), w])
 
     def _cost(self, problem: _Problem, u: np.ndarray) -> float:
@@ -375,7 +378,7 @@ class TebPlanner:
         poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
         track, heading, const = self._residuals(problem, u, poses)
         violation = np.maximum(cfg.safety_distance - np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T), 0.0)
-        return float(self._w_track @ track**2 + cfg.weight_goal_heading * heading**2 + self._w_const @ const**2
+        return float(self._w_track @ track**2 + self._w_heading @ heading**2 + self._w_const @ const**2
                      + cfg.weight_clearance_slack * violation @ violation + cfg.weight_clearance_l1 * violation.sum())
 
     def _cost_to_go(self, problem: _Problem, u: np.ndarray) -> float:
@@ -431,8 +434,7 @@ class TebPlanner:
         q = self._q
         track, heading, const = self._residuals(problem, u, poses)
         q[: 2 * M] = 2.0 * self._w_track * track
-        q[2 * M : 3 * M] = 0.0
-        q[3 * M - 1] = 2.0 * cfg.weight_goal_heading * heading
+        q[2 * M : 3 * M] = 2.0 * self._w_heading * heading
         q[3 * M : 5 * M] = 2.0 * self._Jc.T @ (self._w_const * const)
         lo, hi = self._lo, self._hi
         lo[3 * M : 5 * M] = np.maximum((self._u_lo if lower is None else lower) - u, -self._trust)

@@ -70,7 +70,7 @@ def test_evaluate_rejects_unknown_scenarios(capsys):
 def test_train_prior_weight_option_reaches_the_run_config_and_bad_values_are_refused(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--prior-weight", "-1", "--out", str(run)]) == 2
-    assert "prior_weight must be >= 0" in capsys.readouterr().err
+    assert "argument --prior-weight: must be a number from 0" in capsys.readouterr().err
     assert not run.exists()  # refused before anything is written
     assert main(["train", "--prior-weight", "0.25", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
     assert json.loads((run / "config.json").read_text())["prior_weight"] == 0.25

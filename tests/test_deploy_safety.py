@@ -4,8 +4,6 @@ are locked. All traffic is on 127.0.0.1; every loop is bounded in count and time
 
 import json
 import logging
-import math
-import os
 import signal
 import socket
 import subprocess

@@ -7,20 +7,12 @@ from pathlib import Path
 
 import torch
 
+from lbgp.files import atomic_file
+
 
 def save_atomic(obj, path: str | os.PathLike) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "wb") as f:
-            torch.save(obj, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)  # e.g. a full disk: the previous file stays, no half-written one
-        raise
+    with atomic_file(path, "wb") as f:  # a full disk leaves the previous file and no temporary one
+        torch.save(obj, f)
 
 
 def load_checked(path: str | os.PathLike, expected_format: str) -> dict:
@@ -31,7 +23,9 @@ def load_checked(path: str | os.PathLike, expected_format: str) -> dict:
     try:
         data = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # truncated zip, wrong magic, disallowed pickle content, ...
-        raise ValueError(f"{path} is not a readable {expected_format} file (corrupt or truncated?): {exc}") from exc
+        reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:120]  # torch's advice runs for lines
+        raise ValueError(f"{path} is not a readable {expected_format} file written by lbgp (corrupt, truncated or "
+                         f"foreign: {reason})") from None
     if not isinstance(data, dict) or data.get("format") != expected_format:
         found = data.get("format") if isinstance(data, dict) else type(data).__name__
         raise ValueError(f"{path} is not a {expected_format} file (found format {found!r})")

@@ -69,11 +69,15 @@ def load_policy(path) -> Policy:
             f"frames; this lbgp builds {obs_lib.SIZE} of {obs_lib.FRAMES}"
         )
     if data.get("method") not in ("lbgp", "e2e"):
-        raise ValueError(f"{path}: unknown policy method {data.get('method')!r}")
-    actor = Actor(data["obs_size"], data["action_size"], tuple(data["hidden"]))
+        raise ValueError(f"{path}: unknown policy method {data.get('method')!r} (expected an lbgp policy for method lbgp or e2e)")
+    expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
+        actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]))
         actor.load_state_dict(data["actor"])
-    except (RuntimeError, KeyError) as exc:
-        raise ValueError(f"{path}: actor weights do not match the stored sizes: {exc}") from exc
-    meta = {k: data[k] for k in ("robot", "hidden", "extra")}
+        meta = {k: data[k] for k in ("robot", "hidden", "extra")}
+    except (RuntimeError, KeyError, TypeError, ValueError, AttributeError) as exc:
+        reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:120]
+        raise ValueError(f"{path}: malformed policy file, expected {expected} ({type(exc).__name__}: {reason})") from None
+    if int(data["action_size"]) != 2:
+        raise ValueError(f"{path}: policy has {data['action_size']} outputs, expected {expected}")
     return Policy(actor, data["method"], meta)

@@ -30,6 +30,7 @@ import torch
 
 from lbgp.agent.actors import InlineActors, ProcessActors, flat_parameters
 from lbgp.agent.checkpoint import load_checked, save_atomic
+from lbgp.files import atomic_file, write_json
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
@@ -45,10 +46,7 @@ class Stop(Exception):
     """Raised by the SIGTERM handler so that the run checkpoints and stops cleanly."""
 
 
-def _write_json(path: Path, data) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2) + "\n")
-    os.replace(tmp, path)
+_write_json = write_json
 
 
 def read_curve(path: str | os.PathLike) -> list[dict]:
@@ -180,13 +178,11 @@ class Trainer:
         self.rng.bit_generator.state = json.loads(data["numpy_rng"])
         # curve rows newer than the checkpoint belong to lost work: drop them
         rows = [r for r in read_curve(self.dir / "curve.csv") if r["env_steps"] <= self.env_steps]
-        tmp = self.dir / "curve.csv.tmp"
-        with tmp.open("w", newline="") as f:
+        with atomic_file(self.dir / "curve.csv", newline="") as f:
             w = csv.writer(f)
             w.writerow(CURVE_HEADER)
             for r in rows:
                 w.writerow([r["env_steps"], f"{r['wall_time_s']:.2f}", r["level"], f"{r['exploit_return']:.4f}"])
-        os.replace(tmp, self.dir / "curve.csv")
 
     # ------------------------------------------------------------------ the loop
     def _make_actors(self):

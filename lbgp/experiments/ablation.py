@@ -7,8 +7,9 @@ easier levels (the paper plots it the same way).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
+
+from lbgp.files import write_json
 
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.train import train
@@ -37,7 +38,5 @@ def run_ablation(out_dir="results", minutes: float = 10.0, seeds=(0, 1), steps: 
             labels.append(label)
     plot_learning_curves(dirs, out_dir / "ablation_curves.png", labels=labels)
     report = {"command": command or "lbgp experiment ablation", "minutes_per_run": minutes, "seeds": list(seeds), "runs": summaries}
-    tmp = out_dir / "ablation.json.partial"
-    tmp.write_text(json.dumps(report, indent=2) + "\n")
-    tmp.replace(out_dir / "ablation.json")
+    write_json(out_dir / "ablation.json", report)
     return report

@@ -73,6 +73,9 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
     out_dir = Path(out_dir)
     policies = policies or {}
     paths = list(paths or PATHS)
+    unknown = [p for p in paths if p not in PATHS]
+    if unknown:
+        raise ValueError(f"unknown protocol path {', '.join(map(repr, unknown))}; use {', '.join(PATHS)}")
     rows, pictures = [], {}
     for method in methods:
         policy = make_policy(method, policies.get(method))

@@ -5,8 +5,9 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
 from pathlib import Path
+
+from lbgp.files import write_text
 
 METHOD_NAMES = {"lbgp": "LBGP", "hc": "HC", "e2e": "E2E"}
 
@@ -76,9 +77,4 @@ def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: P
     _atomic_text(out_csv, buf.getvalue())
 
 
-def _atomic_text(path: Path, text: str) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+_atomic_text = write_text

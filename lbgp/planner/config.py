@@ -47,8 +47,7 @@ class PlannerConfig:
     # end past this budget (at least one always runs); None: iterate to step_tolerance (simulation, reproducible)
     trust_region_v: float = 0.75  # m/s change of each segment's v per iteration
     trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
-    step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this,
-    cost_tolerance: float = 0.0  # or when the objective falls by less than this share in an iteration
+    step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this
     turn_around_candidate: bool = True  # turn to face a goal behind the robot when that is faster than backing up
     weight_time_to_go: float = 2.0  # per s: candidate bands are compared with the time they leave to the goal
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person

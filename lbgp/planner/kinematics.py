@@ -6,13 +6,8 @@ for h seconds. Each segment is integrated with the midpoint heading,
     theta_{k+1} = theta_k + w_k h
     p_{k+1}     = p_k + v_k h (cos phi_k, sin phi_k),   phi_k = theta_k + w_k h / 2,
 
-so the band is non-holonomic by construction, and its Jacobian has a closed form:
-
-    dp_i / dv_k = h (cos phi_k, sin phi_k)                                   (k < i)
-    dp_i / dw_k = R90 ((p_{k+1} - p_k) / 2 + (p_i - p_{k+1})) h              (k < i)
-
-(R90 rotates by +90 degrees; p_{k+1} - p_k = v_k h (cos phi_k, sin phi_k)). Everything is
-vectorised over the band: no Python loop per pose.
+so the band is non-holonomic by construction. The rollout is vectorised over the band; the
+planner linearises these same equations (one segment at a time) as the equality rows of its QP.
 """
 
 from __future__ import annotations
@@ -33,25 +28,6 @@ def rollout(pose0, v: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
     poses[1:, 1] = pose0[1] + np.cumsum(h * v * np.sin(phi))
     poses[:, 2] = theta
     return poses
-
-
-def position_jacobian(poses: np.ndarray, w: np.ndarray, h: float, lower: np.ndarray):
-    """d(x_i, y_i)/d(v, w) for the poses i = 1..M: two (M, 2M) arrays (columns v_0..v_{M-1}, then
-    w_0..w_{M-1}). ``lower[i-1, k]`` is True where k < i (precomputed by the caller)."""
-    M = len(w)
-    xy = poses[:, :2]
-    step = xy[1:] - xy[:-1]  # p_{k+1} - p_k
-    phi = poses[:-1, 2] + 0.5 * h * w
-    Jx = np.empty((M, 2 * M))
-    Jy = np.empty((M, 2 * M))
-    Jx[:, :M] = np.where(lower, h * np.cos(phi)[None, :], 0.0)
-    Jy[:, :M] = np.where(lower, h * np.sin(phi)[None, :], 0.0)
-    # lever arm of w_k on pose i: (p_{k+1} - p_k) / 2 + (p_i - p_{k+1}), rotated by +90 degrees
-    lever_x = 0.5 * step[None, :, 0] + (xy[1:, None, 0] - xy[None, 1:, 0])
-    lever_y = 0.5 * step[None, :, 1] + (xy[1:, None, 1] - xy[None, 1:, 1])
-    Jx[:, M:] = np.where(lower, -h * lever_y, 0.0)
-    Jy[:, M:] = np.where(lower, h * lever_x, 0.0)
-    return Jx, Jy
 
 
 def pursuit_commands(pose0, v_start: float, w_start: float, goal_path, goal_vel, h: float, first_period: float,

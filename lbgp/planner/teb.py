@@ -49,7 +49,7 @@ import scipy.sparse as sp
 
 from lbgp.geometry import wrap_angle
 from lbgp.planner.config import PlannerConfig
-from lbgp.planner.kinematics import position_jacobian, pursuit_commands, rollout
+from lbgp.planner.kinematics import pursuit_commands, rollout
 
 OK = "ok"
 INVALID_INPUT = "invalid_input"
@@ -394,11 +394,9 @@ class TebPlanner:
 
     def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int, lower: np.ndarray):
         """SQP from the commands ``u``; returns (u, status, iterations). Converged when no command
-        moves more than ``step_tolerance`` or the objective falls by less than ``cost_tolerance``
-        (relative) in an iteration."""
-        cfg, M = self.cfg, self.M
+        moves more than ``step_tolerance`` in an iteration."""
+        cfg = self.cfg
         u = np.clip(u, lower, self._u_hi)
-        cost = self._cost(problem, u)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
@@ -410,8 +408,7 @@ class TebPlanner:
             u = np.clip(u + step, lower, self._u_hi)
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
-            previous, cost = cost, self._cost(problem, u)
-            if float(np.max(np.abs(step))) < cfg.step_tolerance or previous - cost < cfg.cost_tolerance * previous:
+            if float(np.max(np.abs(step))) < cfg.step_tolerance:
                 break
         return u, OK, done
 

@@ -31,6 +31,10 @@ class PathError(ValueError):
     """A person path that cannot be used (bad file, bad values, too few points)."""
 
 
+MAX_PATH_LENGTH = 10_000.0  # m: a walk, not a continent (the path is resampled at a few cm)
+MAX_WAYPOINTS = 1_000_000
+
+
 def validate_path(points, source: str = "path") -> np.ndarray:
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
@@ -42,6 +46,9 @@ def validate_path(points, source: str = "path") -> np.ndarray:
         raise PathError(f"{source}: waypoint {bad} is not a finite number: {pts[bad].tolist()}")
     if path_length(pts) <= 1e-6:
         raise PathError(f"{source}: all waypoints are the same point")
+    if len(pts) > MAX_WAYPOINTS or path_length(pts) > MAX_PATH_LENGTH:
+        raise PathError(f"{source}: a person path may have at most {MAX_WAYPOINTS:,} waypoints and be at most "
+                        f"{MAX_PATH_LENGTH / 1000:g} km long, got {len(pts):,} waypoints over {path_length(pts) / 1000:.3g} km")
     return pts
 
 
@@ -70,14 +77,13 @@ def load_path_csv(path) -> np.ndarray:
 
 def save_path_csv(path, points) -> None:
     pts = validate_path(points)
-    path = Path(path)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    with tmp.open("w", newline="") as f:
+    from lbgp.files import atomic_file
+
+    with atomic_file(path, newline="") as f:
         w = csv.writer(f)
         w.writerow(["x", "y"])
         for x, y in pts:
             w.writerow([f"{x:.4f}", f"{y:.4f}"])
-    tmp.replace(path)
 
 
 def resample_path(points, spacing: float = SPACING) -> np.ndarray:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from lbgp.files import atomic_file
+
 import numpy as np
 
 
@@ -57,9 +59,7 @@ def plot_trajectories(panels: dict[str, dict], out: str | os.PathLike, title: st
         fig.suptitle(title)
     fig.tight_layout()
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(out.stem + ".partial.png")
-    fig.savefig(tmp, dpi=90)
+    with atomic_file(out, "wb") as f:
+        fig.savefig(f, dpi=90, format="png")
     plt.close(fig)
-    os.replace(tmp, out)
     return out

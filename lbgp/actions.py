@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-DESIRED_GOAL = (1.5, 0.0)  # m, person frame: where the reward peaks (D = 1.5 m, alpha = 0)
+from lbgp.conventions import DESIRED_GOAL  # noqa: F401 - m, person frame: where the reward peaks (re-exported)
+
 GOAL_X = (-1.0, 3.0)  # m, person frame
 GOAL_Y = (-2.0, 2.0)  # m, person frame
 MAX_V = 1.0  # m/s
@@ -47,3 +48,6 @@ def velocity_from_action(action) -> tuple[float, float]:
     """[-1, 1]^2 -> (v, w) = (a0 * 1 m/s, a1 * 2 rad/s)."""
     a = _check(action)
     return float(a[0] * MAX_V), float(a[1] * MAX_W)
+
+
+__all__ = ["DESIRED_GOAL", "GOAL_X", "GOAL_Y", "MAX_V", "MAX_W", "goal_from_action", "action_from_goal", "velocity_from_action"]

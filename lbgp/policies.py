@@ -8,11 +8,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from lbgp.conventions import DESIRED_DISTANCE
+
 METHODS = ("lbgp", "e2e", "hc", "scripted")
 PRETRAINED = Path(__file__).resolve().parent / "agent" / "pretrained"
 # horizon 0: the planner already moves the goal with the person's velocity (GoalController), so an EKF
 # forecast on top double-counts (measured: straight_ahead reward 25.6 at 0 s vs 22.2 at 0.4 s vs 10.7 at 1 s)
-HC_DEFAULTS = {"distance": 1.5, "horizon": 0.0}
+HC_DEFAULTS = {"distance": DESIRED_DISTANCE, "horizon": 0.0}
 
 
 def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:

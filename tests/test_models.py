@@ -4,7 +4,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from lbgp.sim.robots import JACKAL, ROBOTS, TURTLEBOT2, DiffDrive, get_robot
+from lbgp.robots import JACKAL, ROBOTS, TURTLEBOT2, DiffDrive, get_robot
 from lbgp.sim.tasks import load_physics
 
 
@@ -73,7 +73,7 @@ def test_turtlebot_top_speed_is_about_0_7():
 
 
 def test_malformed_mjcf_raises_clear_error(tmp_path, monkeypatch):
-    import lbgp.sim.robots as robots
+    import lbgp.robots as robots
 
     bad_dir = tmp_path / "mjcf" / "jackal"
     bad_dir.mkdir(parents=True)

@@ -142,7 +142,7 @@ def simulate(robot, start, goal, person0, person_vel, seconds=8.0):
     """The planner drives the MuJoCo robot at 10 Hz towards a world-fixed goal while the person
     (kinematic) walks at constant velocity. Returns robot-person distance at every 5 ms physics
     step, whether they touched, and the final robot pose."""
-    from lbgp.sim.robots import get_robot
+    from lbgp.robots import get_robot
     from lbgp.sim.tasks import load_physics
 
     spec = get_robot(robot)

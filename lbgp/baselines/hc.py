@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from lbgp.actions import action_from_goal
+from lbgp.conventions import DESIRED_DISTANCE
 from lbgp.baselines.ekf import PersonEKF
 from lbgp.sim import observation as obs_lib
 
@@ -26,7 +27,7 @@ class HCPolicy:
     control = "goal"
     method = "hc"
 
-    def __init__(self, distance: float = 1.5, horizon: float = 0.0, turn_rate: bool = True):
+    def __init__(self, distance: float = DESIRED_DISTANCE, horizon: float = 0.0, turn_rate: bool = True):
         self.distance = distance  # m ahead of the predicted person
         self.horizon = horizon  # s of prediction
         self.turn_rate = turn_rate
@@ -36,10 +37,8 @@ class HCPolicy:
 
     def goal(self, observation) -> np.ndarray:
         """The goal (x, y) in the current person frame."""
-        raw = obs_lib.unscale(np.asarray(observation, dtype=float))
-        frames = (len(raw) - 3) // 6 + 1
-        people = [raw[3 + 6 * (i - 1) : 6 + 6 * (i - 1)] for i in range(frames - 1, 0, -1)]  # oldest first
-        people.append(np.zeros(3))  # the current person pose is the frame's origin
+        _, people = obs_lib.split(obs_lib.unscale(np.asarray(observation, dtype=float)))
+        people = people[::-1]  # oldest first; the last is the person now, the frame's origin
         ekf = PersonEKF(turn_rate=self.turn_rate)
         for pose in people:
             ekf.step(pose, obs_lib.FRAME_PERIOD)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from lbgp.sim.robots import JACKAL, TURTLEBOT2, RobotSpec, get_robot
+from lbgp.robots import JACKAL, TURTLEBOT2, RobotSpec, get_robot
 
 PERSON_RADIUS = 0.25  # m, half the shoulder width of the simulated person
 
@@ -24,6 +24,7 @@ class PlannerConfig:
     max_vel_theta: float = 2.0  # rad/s
     acc_lim_x: float = 1.5  # m/s^2
     acc_lim_theta: float = 3.0  # rad/s^2
+    lateral_acc_limit: float = 1.0  # m/s^2: |v w| at most this (turn gently at speed; a skid-steer base slips less then)
     footprint_radius: float = 0.27  # m
     person_radius: float = PERSON_RADIUS
     safety_margin: float = 0.08  # m, clearance kept between footprint and person

@@ -26,11 +26,11 @@ No hidden state: every call starts from the same deterministic first guess (a pu
 moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
 and velocity, person pose and velocity, goal) alone; OSQP's warm start (the previous QP's solution)
 only saves ADMM iterations: every QP is solved to ``osqp_eps`` and polished.
-Local minima (TEB's idea of bands in distinct topologies): for a goal that will still be behind
-the robot at the end of the horizon, the band's direction is chosen by comparing the time to turn
-around and drive there with the time to back up there (a forwards-only band when turning wins);
-when the band passes near the person's predicted path, a second band that starts by braking (let
-the person cross first) is solved too, and the cheaper of the two is kept.
+Local minima (TEB's remedy: bands in distinct topologies): for a goal that will still be behind
+the robot at the end of the horizon, a forwards-only band that turns the robot around is solved
+beside the one that may back up; when the band passes near the person's predicted path, one that
+starts by braking (let the person cross first). The cheapest band is kept, its cost including the
+time it leaves to the goal (at the speed its last pose allows towards the goal).
 
 A goal within the person's safety distance, bad input, a failed QP, or a next pose that would go
 deeper into the person's safety radius returns a safe stop (decelerate within limits) with a
@@ -199,7 +199,9 @@ class TebPlanner:
             goal_yaw=goal_yaw,
             person_path=person_path,
         )
-        candidates = ["turn" if cfg.turn_around_candidate and self._turning_around_is_faster(problem) else "keep"]
+        candidates = ["keep"]
+        if cfg.turn_around_candidate and self._goal_behind(problem):
+            candidates.append("turn")
         best, iterations = None, 0
         while candidates:
             name = candidates.pop(0)
@@ -214,7 +216,7 @@ class TebPlanner:
                 if best is not None:
                     continue  # an extra candidate that failed is just not a candidate
                 return self._stop(v_now, w_now, status, t_start, None, problem, iterations)
-            cost = self._cost(problem, u) + self._cost_to_go(problem, u)
+            cost = self._candidate_score(problem, u)
             if best is None or cost < best[0] - 1e-9:
                 best = (cost, u, name)
             if name != "wait" and cfg.wait_candidate and self._near_person(problem, u):
@@ -229,26 +231,13 @@ class TebPlanner:
         return self._result(v, w, OK, poses, problem, iterations, t_start, name)
 
     # ------------------------------------------------------------------ helpers
-    def _turning_around_is_faster(self, problem: _Problem) -> bool:
-        """Whether to turn the robot's front towards a goal behind it rather than back up to it.
-
-        Where the goal will be at the end of the horizon (a moving goal that will have caught up
-        is met by slowing down or waiting, never by turning): if that is behind the robot, compare
-        the time to turn the front towards it and drive there with the time to turn the back
-        towards it and reverse there (turn at ``max_vel_theta``, drive at the speed limit). The
-        rule only picks the first guess and the band's direction; the decision moves away from the
-        boundary as the robot executes it (no chattering between the two)."""
-        cfg = self.cfg
+    def _goal_behind(self, problem: _Problem) -> bool:
+        """Whether the goal, where it will be at the end of the horizon, lies behind the robot (a
+        moving goal that will have caught up by then is met by slowing down or waiting: only a
+        goal still behind makes turning around worth trying)."""
         x, y, th = problem.pose0
         g = problem.goal_path[-1]
-        dx, dy = g[0] - x, g[1] - y
-        bearing = math.remainder(math.atan2(dy, dx) - th, 2.0 * math.pi)
-        if abs(bearing) <= 0.5 * math.pi:
-            return False
-        distance = math.hypot(dx, dy)
-        forwards = abs(bearing) / cfg.max_vel_theta + distance / cfg.max_vel_x
-        backwards = (math.pi - abs(bearing)) / cfg.max_vel_theta + distance / max(cfg.max_vel_x_backwards, 1e-3)
-        return forwards < backwards
+        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < 0.0
 
     def _forward_only(self, problem: _Problem) -> np.ndarray:
         """Command lower bounds of a forwards-only band: v >= 0 from the moment the robot can have
@@ -372,47 +361,59 @@ class TebPlanner:
         heading = wrap_angle(poses[1:, 2] - problem.goal_yaw)
         return track, heading, np.concatenate([np.diff(v, prepend=problem.v_ref), np.diff(w, prepend=problem.w_ref), w])
 
-    def _cost(self, problem: _Problem, u: np.ndarray) -> float:
-        """The objective at the commands ``u`` (nonlinear, with the clearance penalty)."""
+    def _candidate_score(self, problem: _Problem, u: np.ndarray) -> float:
+        """How candidate bands are ranked: the objective's position, command and clearance terms
+        over the band (not the headings along it: turning around costs heading on the way), plus
+        what the band leaves undone, ``weight_time_to_go`` times the time to cover the remaining
+        distance to the goal at the speed the band's last pose allows towards it (forwards if the
+        goal is in front of it, backwards otherwise) and to turn to the goal's heading there."""
         cfg = self.cfg
         poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
         track, heading, const = self._residuals(problem, u, poses)
         violation = np.maximum(cfg.safety_distance - np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T), 0.0)
-        return float(self._w_track @ track**2 + self._w_heading @ heading**2 + self._w_const @ const**2
-                     + cfg.weight_clearance_slack * violation @ violation + cfg.weight_clearance_l1 * violation.sum())
-
-    def _cost_to_go(self, problem: _Problem, u: np.ndarray) -> float:
-        """What a band leaves undone, for comparing candidate bands beyond the horizon: the time to
-        cover the remaining distance to the goal at the speed the band's last pose allows towards
-        it (forwards if the goal is in front of it, backwards otherwise), times ``weight_time_to_go``."""
-        cfg = self.cfg
-        end = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)[-1]
+        end = poses[-1]
         d = problem.goal_path[-1] - end[:2]
         ahead = math.cos(end[2]) * d[0] + math.sin(end[2]) * d[1]
         speed = cfg.max_vel_x if ahead >= 0.0 else max(cfg.max_vel_x_backwards, 1e-3)
-        return cfg.weight_time_to_go * float(np.hypot(*d)) / speed
+        time_to_go = float(np.hypot(*d)) / speed + abs(float(heading[-1])) / cfg.max_vel_theta
+        return float(self._w_track @ track**2 + self._w_const @ const**2 + cfg.weight_clearance_slack * violation @ violation
+                     + cfg.weight_clearance_l1 * violation.sum() + cfg.weight_time_to_go * time_to_go)
 
     def _solve_band(self, problem: _Problem, u: np.ndarray, t_start: float, spent_iterations: int, lower: np.ndarray):
         """SQP from the commands ``u``; returns (u, status, iterations). Converged when no command
         moves more than ``step_tolerance`` in an iteration."""
         cfg = self.cfg
-        u = np.clip(u, lower, self._u_hi)
+        lo, hi = self._bounds(problem, u, lower)
+        u = np.clip(u, lo, hi)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
                 done -= 1
                 break
-            step, status = self._sqp_step(problem, u, lower)
+            step, status = self._sqp_step(problem, u, *self._bounds(problem, u, lower))
             if status != OK:
                 return u, status, done
-            u = np.clip(u + step, lower, self._u_hi)
+            u = np.clip(u + step, *self._bounds(problem, u + step, lower))
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
             if float(np.max(np.abs(step))) < cfg.step_tolerance:
                 break
         return u, OK, done
 
-    def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray | None = None):
+    def _bounds(self, problem: _Problem, u: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Command bounds: the velocity limits, and |w| <= lateral_acc_limit / |v| (evaluated at the
+        current v; a fast robot turns gently), never tighter than what the angular acceleration
+        limit lets the robot reach from its current turn rate."""
+        cfg, M = self.cfg, self.M
+        cap = np.minimum(cfg.max_vel_theta, cfg.lateral_acc_limit / np.maximum(np.abs(u[:M]), 1e-6))
+        reachable = abs(problem.w_ref) - cfg.acc_lim_theta * (cfg.control_period + self.h * np.arange(M))
+        cap = np.maximum(cap, reachable)
+        lo, hi = lower.copy(), self._u_hi.copy()
+        lo[M:] = np.maximum(lo[M:], -cap)
+        hi[M:] = np.minimum(hi[M:], cap)
+        return lo, hi
+
+    def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray | None = None, upper: np.ndarray | None = None):
         cfg, M, h = self.cfg, self.M, self.h
         v, w = u[:M], u[M:]
         poses = rollout(problem.pose0, v, w, h)
@@ -435,7 +436,7 @@ class TebPlanner:
         q[3 * M : 5 * M] = 2.0 * self._Jc.T @ (self._w_const * const)
         lo, hi = self._lo, self._hi
         lo[3 * M : 5 * M] = np.maximum((self._u_lo if lower is None else lower) - u, -self._trust)
-        hi[3 * M : 5 * M] = np.maximum(np.minimum(self._u_hi - u, self._trust), lo[3 * M : 5 * M])
+        hi[3 * M : 5 * M] = np.maximum(np.minimum((self._u_hi if upper is None else upper) - u, self._trust), lo[3 * M : 5 * M])
         dv = np.diff(v, prepend=problem.v_ref)
         dw = np.diff(w, prepend=problem.w_ref)
         lo[6 * M : 7 * M], hi[6 * M : 7 * M] = -self._acc_v - dv, self._acc_v - dv

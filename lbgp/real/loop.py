@@ -28,15 +28,15 @@ import time
 
 import numpy as np
 
-from lbgp.control import GoalController, VelocityController
+from lbgp import stack
+from lbgp.conventions import PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha
 from lbgp.metrics import EpisodeMetrics
-from lbgp.planner import TebPlanner, clamp_command, planner_config_for
+from lbgp.planner import clamp_command
 from lbgp.real import safety as safety_lib
 from lbgp.real.safety import SafetyConfig, SafetyMonitor
 from lbgp.sim import observation as obs_lib
 from lbgp.sim.rewards import follow_ahead_reward
-from lbgp.sim.robots import get_robot
 from lbgp.world import WorldState
 
 SHUTDOWN = "shutdown"
@@ -68,7 +68,7 @@ class WallClock:
 @dataclasses.dataclass
 class DeployConfig:
     robot: str = "turtlebot2"
-    planner_period: float = 0.1  # s between commands
+    planner_period: float = PLANNER_PERIOD  # s between commands
     max_steps: int | None = None  # agent steps (0.2 s) before the loop ends; None: until stopped
     max_duration: float | None = None  # s of loop clock before the loop ends (counts stopped time too)
     planner_time_budget: float | None = None  # s: anytime SQP budget per planner call (None: as in simulation)
@@ -105,11 +105,8 @@ class DeployLoop:
         self.clock = clock or getattr(source, "clock", None) or WallClock()
         self.logger, self.recorder = logger, recorder
         self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
-        self.limits = dataclasses.replace(planner_config_for(get_robot(self.cfg.robot)), sqp_time_budget=self.cfg.planner_time_budget)
-        if policy.control == "goal":
-            self.controller = GoalController(TebPlanner(self.limits))
-        else:
-            self.controller = VelocityController(self.limits)
+        self.limits = stack.planner_limits(self.cfg.robot, self.cfg.planner_period, time_budget=self.cfg.planner_time_budget)
+        self.controller = stack.make_controller(policy.control, self.limits)
         self.monitor = SafetyMonitor(self.cfg.safety)
         self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance
         self.stack = obs_lib.ObservationStack()

@@ -26,7 +26,7 @@ import numpy as np
 from lbgp.real.frames import PoseFrame, encode_frame
 from lbgp.real.udp import UdpCommandListener, sending_socket
 from lbgp.sim import tasks
-from lbgp.sim.robots import get_robot
+from lbgp.robots import get_robot
 
 FRAME_PERIOD = 0.02  # s between mocap frames (50 Hz)
 
@@ -78,13 +78,10 @@ class SimWorld:
         """Advance one mocap frame period: person along its motion, robot by physics."""
         task, physics = self.task, self.physics
         self._phase += FRAME_PERIOD
-        task.move_person(physics, task.person_pose_at(self._phase))
-        physics.step_physics(self.substeps)
-        self.contact = self.contact or physics.robot_person_contact()
+        self.contact = task.advance(physics, self._phase, self.substeps) or self.contact
         self.time = round(self.time + FRAME_PERIOD, 9)
         if self._phase >= tasks.CONTROL_PERIOD - 1e-9:  # the person's motion model runs at 5 Hz
-            task.after_step(physics)
-            task.begin_person_step()
+            task.end_agent_step(physics)
             self._phase = 0.0
         for listener in self.listeners:
             listener(self)

@@ -1,7 +1,7 @@
 """Simulation: MuJoCo robots and person, follow-ahead tasks (dm_env) and a Gymnasium wrapper.
 
-``from lbgp.sim import make_env`` is the entry point. Names are imported lazily so that
-``lbgp.sim.robots`` (needed by the planner and the real robot) does not pull in the simulator.
+``from lbgp.sim import make_env`` is the entry point. Names are imported lazily, so that importing a
+light module of the package (e.g. ``lbgp.sim.observation``) does not load MuJoCo.
 """
 
 import importlib
@@ -15,8 +15,8 @@ _EXPORTS = {
     "PathError": "lbgp.sim.paths",
     "load_path_csv": "lbgp.sim.paths",
     "follow_ahead_reward": "lbgp.sim.rewards",
-    "ROBOTS": "lbgp.sim.robots",
-    "get_robot": "lbgp.sim.robots",
+    "ROBOTS": "lbgp.robots",
+    "get_robot": "lbgp.robots",
 }
 
 __all__ = sorted(_EXPORTS)

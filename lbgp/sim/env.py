@@ -11,8 +11,9 @@ from __future__ import annotations
 import dm_env
 import numpy as np
 
+from lbgp.conventions import DESIRED_GOAL, PLANNER_PERIOD
+from lbgp.robots import get_robot
 from lbgp.sim import tasks
-from lbgp.sim.robots import get_robot
 
 
 def _divides(period: float, step: float, what: str) -> int:
@@ -28,7 +29,7 @@ class FollowAheadEnv(dm_env.Environment):
         physics: tasks.Physics,
         task: tasks.FollowAheadTask,
         horizon: int = tasks.DEFAULT_HORIZON,
-        planner_period: float = 0.1,
+        planner_period: float = PLANNER_PERIOD,
         person_substeps: int = 10,
     ):
         self.physics = physics
@@ -57,6 +58,7 @@ class FollowAheadEnv(dm_env.Environment):
     def reset(self) -> dm_env.TimeStep:
         self.physics.reset()
         self.task.initialize_episode(self.physics)
+        self.task.begin_person_step()
         self._steps = 0
         self._reset_next_step = False
         return dm_env.restart(self.task.get_observation(self.physics))
@@ -66,19 +68,15 @@ class FollowAheadEnv(dm_env.Environment):
             return self.reset()
         task, physics = self.task, self.physics
         task.before_step(action, physics)
-        task.begin_person_step()
-        person_poses = task.person_pose_at(self._person_times)
         contact = False
         k = 0
         for _ in range(self.n_plan):
             task.apply_command(physics)
             for _ in range(self.n_person):
-                task.move_person(physics, person_poses[k])
+                contact = task.advance(physics, self._person_times[k], self.person_substeps) or contact
                 k += 1
-                physics.step_physics(self.person_substeps)
-                contact = contact or physics.robot_person_contact()
         task.contact = contact
-        task.after_step(physics)
+        task.end_agent_step(physics)
         self._steps += 1
         reward = task.get_reward(physics)
         observation = task.get_observation(physics)
@@ -121,7 +119,7 @@ def make_env(
     obs_noise: bool | None = None,
     person_path=None,
     planner_config=None,
-    planner_period: float = 0.1,
+    planner_period: float = PLANNER_PERIOD,
 ) -> FollowAheadEnv:
     """A follow-ahead environment.
 
@@ -139,13 +137,13 @@ def make_env(
     """
     setting = tasks.get_setting(level)
     if person_path is not None:
-        spawn = setting.spawn if setting.spawn is not None else (1.5, 0.0)
+        spawn = setting.spawn if setting.spawn is not None else DESIRED_GOAL
         setting = tasks.path_setting(person_path, spawn=spawn)
     spec = get_robot(robot)
     physics = tasks.load_physics(spec)
     task = tasks.FollowAheadTask(
         spec, setting, control_mode=control, obs_noise=obs_noise, planner_config=planner_config,
-        random=np.random.default_rng(seed),
+        random=np.random.default_rng(seed), planner_period=planner_period,
     )
     return FollowAheadEnv(physics, task, horizon=horizon, planner_period=planner_period)
 

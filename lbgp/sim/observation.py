@@ -23,10 +23,11 @@ import math
 
 import numpy as np
 
+from lbgp.conventions import AGENT_PERIOD
 from lbgp.geometry import to_frame
 
 FRAMES = 10
-FRAME_PERIOD = 0.2  # s, 5 Hz
+FRAME_PERIOD = AGENT_PERIOD  # s, 5 Hz: one frame per agent step
 POSITION_SCALE = 6.0  # m
 ANGLE_SCALE = math.pi
 SIZE = 3 + 6 * (FRAMES - 1)
@@ -80,6 +81,16 @@ def layout(z_r: np.ndarray, z_h: np.ndarray) -> np.ndarray:
     """Interleave relative states newest first: z^r_t, z^h_{t-1}, z^r_{t-1}, ..., z^h_{t-9}, z^r_{t-9}."""
     pairs = np.stack([z_h[1:], z_r[1:]], axis=1).reshape(-1)
     return np.concatenate([z_r[0], pairs])
+
+
+def split(raw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Inverse of :func:`layout`: (z_r, z_h), each (frames, 3), newest first; z_h[0], the person
+    now, is the frame's origin (zeros)."""
+    raw = np.asarray(raw, dtype=float).reshape(-1, 3)
+    pairs = raw[1:].reshape(-1, 2, 3)
+    z_r = np.concatenate([raw[:1], pairs[:, 1]])
+    z_h = np.concatenate([np.zeros((1, 3)), pairs[:, 0]])
+    return z_r, z_h
 
 
 _INV_SCALE = 1.0 / np.array([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE])

@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from lbgp.conventions import DESIRED_DISTANCE
+
 MIN_DISTANCE = 0.5  # m: closer ends the episode
 MAX_DISTANCE = 5.0  # m: farther ends the episode
 CONE_DEG = 25.0  # half-angle of the rewarded cone in front of the person
@@ -23,7 +25,7 @@ def distance_reward(distance: float) -> float:
     if d < 1.0:
         return -(1.0 - d)
     if d <= 2.0:
-        return 0.5 * (0.5 - abs(d - 1.5))
+        return 0.5 * (0.5 - abs(d - DESIRED_DISTANCE))
     return -0.25 * (d - 1.0)
 
 
@@ -53,7 +55,7 @@ def follow_ahead_reward_array(distance, alpha) -> np.ndarray:
     a = np.abs(np.degrees(np.asarray(alpha, dtype=float)))
     r_d = np.select(
         [(d < MIN_DISTANCE) | (d > MAX_DISTANCE), d < 1.0, d <= 2.0],
-        [-1.0, -(1.0 - d), 0.5 * (0.5 - np.abs(d - 1.5))],
+        [-1.0, -(1.0 - d), 0.5 * (0.5 - np.abs(d - DESIRED_DISTANCE))],
         -0.25 * (d - 1.0),
     )
     r_o = np.where(a < CONE_DEG, 0.5 * (CONE_DEG - a) / CONE_DEG, -0.25 * a / 180.0)

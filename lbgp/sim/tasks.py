@@ -17,17 +17,19 @@ from dm_control import mujoco as dm_mujoco
 from dm_control.rl import control
 from dm_env import specs
 
-from lbgp.control import Command, GoalController, VelocityController
+from lbgp import stack
+from lbgp.control import Command
+from lbgp.conventions import AGENT_PERIOD, DESIRED_DISTANCE, PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar, yaw_from_quaternion
-from lbgp.planner import TebPlanner, planner_config_for
 from lbgp.sim import observation as obs_lib
 from lbgp.sim import paths as path_lib
 from lbgp.sim.person import CircleMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
 from lbgp.sim.rewards import follow_ahead_reward, out_of_range
-from lbgp.sim.robots import RobotSpec, actuator_indices
+from lbgp.robots import RobotSpec
+from lbgp.sim.robots import actuator_indices
 from lbgp.world import WorldState
 
-CONTROL_PERIOD = 0.2  # s, one agent step = one observation frame
+CONTROL_PERIOD = AGENT_PERIOD  # s, one agent step = one observation frame
 DEFAULT_HORIZON = 35  # agent steps (the authors' configuration; the paper does not state it)
 SPAWN_DISTANCE = (1.0, 2.5)  # m: training levels start the robot this far from the person (paper)
 
@@ -172,16 +174,17 @@ CURRICULUM = tuple(LEVELS)
 # reward); the paper's turning text swaps the ahead/behind angles, we do not. Inside the turn is
 # on the person's left for a left (w > 0) turn, hence +45 deg.
 _eval = dict(noise=False, random_person_heading=False)
+_D = DESIRED_DISTANCE  # the paper's settings start the robot at the desired distance
 SCENARIOS: dict[str, Setting] = {
-    "straight_ahead": Setting("straight_ahead", lambda: StraightMotion(0.6), (1.5, 0.0), **_eval),
-    "straight_behind": Setting("straight_behind", lambda: StraightMotion(0.6), (1.5, 180.0), **_eval),
-    "turning_ahead": Setting("turning_ahead", lambda: CircleMotion(0.3, 0.3), (1.5, 0.0), **_eval),
-    "turning_behind": Setting("turning_behind", lambda: CircleMotion(0.3, 0.3), (1.5, 180.0), **_eval),
-    "turning_inside": Setting("turning_inside", lambda: CircleMotion(0.3, 0.3), (1.5, 45.0), **_eval),
-    "turning_outside": Setting("turning_outside", lambda: CircleMotion(0.3, 0.3), (1.5, -45.0), **_eval),
-    "trajectory_one": Setting("trajectory_one", _eval_path_motion("one"), (1.5, 0.0), **_eval),
-    "trajectory_two": Setting("trajectory_two", _eval_path_motion("two"), (1.5, 0.0), **_eval),
-    "trajectory_three": Setting("trajectory_three", _eval_path_motion("three"), (1.5, 0.0), **_eval),
+    "straight_ahead": Setting("straight_ahead", lambda: StraightMotion(0.6), (_D, 0.0), **_eval),
+    "straight_behind": Setting("straight_behind", lambda: StraightMotion(0.6), (_D, 180.0), **_eval),
+    "turning_ahead": Setting("turning_ahead", lambda: CircleMotion(0.3, 0.3), (_D, 0.0), **_eval),
+    "turning_behind": Setting("turning_behind", lambda: CircleMotion(0.3, 0.3), (_D, 180.0), **_eval),
+    "turning_inside": Setting("turning_inside", lambda: CircleMotion(0.3, 0.3), (_D, 45.0), **_eval),
+    "turning_outside": Setting("turning_outside", lambda: CircleMotion(0.3, 0.3), (_D, -45.0), **_eval),
+    "trajectory_one": Setting("trajectory_one", _eval_path_motion("one"), (_D, 0.0), **_eval),
+    "trajectory_two": Setting("trajectory_two", _eval_path_motion("two"), (_D, 0.0), **_eval),
+    "trajectory_three": Setting("trajectory_three", _eval_path_motion("three"), (_D, 0.0), **_eval),
 }
 
 ALL_SETTINGS = {**LEVELS, **SCENARIOS}
@@ -196,7 +199,7 @@ def get_setting(name: str) -> Setting:
         ) from None
 
 
-def path_setting(path, spawn=(1.5, 0.0), speed: float = 0.5) -> Setting:
+def path_setting(path, spawn=(DESIRED_DISTANCE, 0.0), speed: float = 0.5) -> Setting:
     """A scenario whose person walks a user-given path (array or CSV file of x,y waypoints)."""
     points = path if isinstance(path, np.ndarray) else path_lib.load_path_csv(path)
     points = path_lib.validate_path(points)
@@ -216,17 +219,13 @@ class FollowAheadTask(control.Task):
         noise_std=obs_lib.DEFAULT_NOISE_STD,
         planner_config=None,
         random: np.random.Generator | int | None = None,
+        planner_period: float = PLANNER_PERIOD,
     ):
         self.spec = spec
         self.setting = setting
         self.motion = setting.motion()
-        self.limits = planner_config or planner_config_for(spec)
-        if control_mode == "goal":
-            self.controller = GoalController(TebPlanner(self.limits))
-        elif control_mode == "velocity":
-            self.controller = VelocityController(self.limits)
-        else:
-            raise ValueError(f"unknown control mode {control_mode!r}; use 'goal' or 'velocity'")
+        self.limits = stack.planner_limits(spec, planner_period, planner_config)
+        self.controller = stack.make_controller(control_mode, self.limits)
         self.control_mode = control_mode
         noise_on = setting.noise if obs_noise is None else obs_noise
         self.stack = obs_lib.ObservationStack(noise_std=noise_std if noise_on else None)
@@ -269,7 +268,12 @@ class FollowAheadTask(control.Task):
     def world_state(self, physics: Physics) -> WorldState:
         person_velocity = obs_lib.estimate_person_velocity(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
         turn_rate = obs_lib.estimate_person_turn_rate(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
-        return WorldState(self.time, physics.robot_pose(), physics.robot_velocity(), self.person_pose.copy(), person_velocity, turn_rate)
+        # the robot's velocity is the last command, as on the real robot (lbgp.real.loop): the
+        # planner's acceleration limits chain from command to command, not from the measured
+        # velocity (a skid-steer base overshoots its yaw rate at speed; chaining from that
+        # measurement forced ever harder turns)
+        commanded = np.array([self.last_command.v, self.last_command.w])
+        return WorldState(self.time, physics.robot_pose(), commanded, self.person_pose.copy(), person_velocity, turn_rate)
 
     # -- stepping (called by lbgp.sim.env.FollowAheadEnv)
     def before_step(self, action, physics: Physics) -> None:
@@ -292,6 +296,20 @@ class FollowAheadTask(control.Task):
     def move_person(self, physics: Physics, pose) -> None:
         self.person_pose = np.asarray(pose, dtype=float)
         physics.set_person_pose(self.person_pose)
+
+    def advance(self, physics: Physics, phase: float, substeps: int) -> bool:
+        """The one stepping sequence of the simulator (used by ``FollowAheadEnv`` and by the
+        simulated deploy world alike): the person to where its motion puts it ``phase`` seconds
+        into the current agent step, then ``substeps`` physics steps; returns whether robot and
+        person touched."""
+        self.move_person(physics, self.person_pose_at(phase))
+        physics.step_physics(substeps)
+        return physics.robot_person_contact()
+
+    def end_agent_step(self, physics: Physics) -> None:
+        """Close an agent step (observation frame, the person's next command) and open the next."""
+        self.after_step(physics)
+        self.begin_person_step()
 
     def after_step(self, physics: Physics) -> None:
         self.time += CONTROL_PERIOD

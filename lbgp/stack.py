@@ -1,0 +1,37 @@
+"""The composition root: how a robot, its planner limits and the controller between the policy and
+the wheels are put together. The simulated task (``lbgp.sim.tasks``) and the deploy loop
+(``lbgp.real.loop``) both build theirs here, so a setting such as the planner period has one home
+and reaches every part that depends on it (the planner's acceleration clamp included)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from lbgp.control import GoalController, VelocityController
+from lbgp.conventions import PLANNER_PERIOD
+from lbgp.planner import PlannerConfig, TebPlanner, planner_config_for
+from lbgp.robots import RobotSpec, get_robot
+
+CONTROL_MODES = ("goal", "velocity")
+
+
+def planner_limits(robot: str | RobotSpec, planner_period: float = PLANNER_PERIOD, config: PlannerConfig | None = None,
+                   time_budget: float | None = None) -> PlannerConfig:
+    """The robot's planner configuration (or ``config``), with the control period set to the period
+    at which the controller is really ticked, and an anytime SQP budget if given (seconds)."""
+    if not planner_period > 0:
+        raise ValueError(f"planner period must be above 0 s, got {planner_period}")
+    spec = robot if isinstance(robot, RobotSpec) else get_robot(robot)
+    base = config or planner_config_for(spec)
+    budget = base.sqp_time_budget if time_budget is None else time_budget
+    return dataclasses.replace(base, control_period=float(planner_period), sqp_time_budget=budget)
+
+
+def make_controller(control: str, limits: PlannerConfig):
+    """``goal``: the policy's goal goes through the planner (LBGP, HC); ``velocity``: the policy's
+    (v, w) is clamped to the limits (E2E)."""
+    if control == "goal":
+        return GoalController(TebPlanner(limits))
+    if control == "velocity":
+        return VelocityController(limits)
+    raise ValueError(f"unknown control mode {control!r}; use 'goal' or 'velocity'")

@@ -65,7 +65,7 @@ def cmd_evaluate(args) -> int:
 
     from lbgp.policies import make_policy
 
-    policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon)
+    policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon, robot=args.robot, transfer=args.transfer)
     names = resolve_names(args.scenario)
     recorder = None
     if args.record or args.spawn:
@@ -135,7 +135,7 @@ def cmd_deploy(args) -> int:
     from lbgp.policies import make_policy
     from lbgp.real.deploy import deploy
 
-    policy = make_policy(args.method, args.policy)
+    policy = make_policy(args.method, args.policy, robot=args.robot, transfer=args.transfer)
     print(f"lbgp deploy: {args.method} policy, source {args.source}, sink {args.sink or 'default'}, robot {args.robot}"
           + (f", logging to {args.log}" if args.log else ""), flush=True)
     previous = _stop_on_signals()
@@ -268,6 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", type=A.output_file, help="write the metrics here")
     p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd) of every episode")
     p.add_argument("--spawn", action="store_true", help="also open a live rerun viewer (when one is installed)")
+    p.add_argument("--transfer", action="store_true", help="allow a policy file trained on another robot (zero-shot transfer)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -326,6 +327,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--log", type=A.output_file, help="write an MCAP log (ROS 2 schemas, opens in Foxglove)")
     p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd)")
     p.add_argument("--spawn", action="store_true", help="open a live rerun viewer")
+    p.add_argument("--transfer", action="store_true",
+                   help="allow a policy file trained on another robot (zero-shot transfer; the shipped Jackal policies always may)")
     p.add_argument("--planner-budget-ms", type=A.nonnegative_float, default=2.0,
                    help="anytime SQP budget per planner call (default 2 ms, keeps pose-to-command latency p99 under 5 ms; 0: "
                         "fixed iteration counts as in simulation)")

@@ -21,9 +21,14 @@ def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:
     return PRETRAINED / f"{method}_{robot}.pt"
 
 
-def make_policy(method: str, policy_file=None, hc_distance: float | None = None, hc_horizon: float | None = None):
+def make_policy(method: str, policy_file=None, hc_distance: float | None = None, hc_horizon: float | None = None,
+                robot: str | None = None, transfer: bool = False):
     """The policy of ``method``: lbgp/e2e load ``policy_file`` (default: the shipped Jackal one),
-    hc builds the EKF baseline, scripted asks for a goal 1.5 m ahead."""
+    hc builds the EKF baseline, scripted asks for a goal 1.5 m ahead.
+
+    A policy file for another method is refused; so is one trained on another robot than
+    ``robot`` unless ``transfer`` (zero-shot transfer, as in the paper's real-robot experiment).
+    The shipped default policies are Jackal-trained and transfer by design."""
     if method in ("lbgp", "e2e"):
         from lbgp.agent import load_policy
 
@@ -33,6 +38,10 @@ def make_policy(method: str, policy_file=None, hc_distance: float | None = None,
         policy = load_policy(path)
         if policy.method != method:
             raise ValueError(f"{path} holds a {policy.method} policy, not {method}")
+        trained_on = policy.meta.get("robot")
+        if robot is not None and trained_on != robot and not (transfer or policy_file is None):
+            raise ValueError(f"{path} holds a {method} policy trained on the {trained_on}, not the {robot}; "
+                             f"pass --transfer to run it on the {robot} anyway (zero-shot transfer)")
         return policy
     if method == "hc":
         from lbgp.baselines.hc import HCPolicy

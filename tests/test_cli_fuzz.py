@@ -201,3 +201,17 @@ def test_bad_files_found_when_read_are_one_line_errors(sandbox):
         assert snapshot(sandbox) == before
     assert not os.path.exists(sandbox / "o")
     np.testing.assert_equal(code, 2)
+
+
+def test_a_policy_for_another_robot_is_refused_unless_transfer_is_asked_for(sandbox):
+    from lbgp.agent.networks import Actor
+    from lbgp.agent.policy import save_policy
+
+    turtle = sandbox / "lbgp_turtlebot2.pt"
+    save_policy(turtle, Actor(57, 2, (32, 32)), "lbgp", "turtlebot2", (32, 32))
+    base = ["evaluate", "--method", "lbgp", "--policy", str(turtle), "--robot", "jackal", "--episodes", "1",
+            "--scenario", "straight_ahead"]
+    code, err = run_cli(base)
+    assert code == 2 and "trained on the turtlebot2, not the jackal" in err and "--transfer" in err
+    code, err = run_cli(base + ["--transfer"])
+    assert code == 0, err

@@ -137,8 +137,10 @@ def test_ros2_sink_needs_rclpy():
 
 # ---------------------------------------------------------------- the loop under fault injection (UDP, manual clock)
 class FaultyTrack:
-    """A person walking straight at 0.5 m/s and a robot that does what it is told (kinematic), sent
-    as UDP frames every 0.1 s, with faults injected by tick index."""
+    """A person walking straight at 0.3 m/s and a robot that does what it is told (kinematic), sent
+    as UDP frames every 0.1 s, with faults injected by tick index. (At 0.5 m/s, near the TurtleBot
+    2's 0.65 m/s, the robot cannot win back between faults what each safety stop costs: the person
+    walks into it and the run ends in too_close stops, which is right, but not what this tests.)"""
 
     def __init__(self):
         self.robot = np.array([1.5, 0.0, 0.0])
@@ -147,7 +149,7 @@ class FaultyTrack:
 
     def advance(self, v, w, dt=0.1):
         self.robot = integrate_unicycle(self.robot, v, w, dt)
-        self.person = self.person + np.array([0.05, 0.0, 0.0])
+        self.person = self.person + np.array([0.03, 0.0, 0.0])
 
     def datagrams(self, k, t):
         good = encode_frame(frame(t, self.robot, self.person))

@@ -78,7 +78,7 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
         raise ValueError(f"unknown protocol path {', '.join(map(repr, unknown))}; use {', '.join(PATHS)}")
     rows, pictures = [], {}
     for method in methods:
-        policy = make_policy(method, policies.get(method))
+        policy = make_policy(method, policies.get(method), robot="turtlebot2", transfer=True)  # the paper: zero-shot
         for path in paths:
             for setting in SETTINGS[path]:
                 collector = TrajectoryCollector()

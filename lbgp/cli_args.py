@@ -39,26 +39,24 @@ def seed(text: str) -> int:
     return value
 
 
-def positive_float(text: str) -> float:
+def _bounded_float(text: str, low: float, high: float, allow_low: bool, rule: str) -> float:
     value = _number(text, float)
-    if not 0.0 < value <= 1e7:
-        raise argparse.ArgumentTypeError(f"must be a number above 0 (and at most 1e7), got {value:g}")
+    if not ((low <= value) if allow_low else (low < value)) or value > high:
+        raise argparse.ArgumentTypeError(f"must be {rule}, got {value:g}")
     return value
+
+
+def positive_float(text: str) -> float:
+    return _bounded_float(text, 0.0, 1e7, False, "a number above 0 (and at most 1e7)")
 
 
 def nonnegative_float(text: str) -> float:
     """>= 0, where 0 means 'off' (documented per option)."""
-    value = _number(text, float)
-    if not 0.0 <= value <= 1e7:
-        raise argparse.ArgumentTypeError(f"must be a number from 0 to 1e7, got {value:g}")
-    return value
+    return _bounded_float(text, 0.0, 1e7, True, "a number from 0 to 1e7")
 
 
 def distance(text: str) -> float:
-    value = _number(text, float)
-    if not 0.0 < value <= 10.0:
-        raise argparse.ArgumentTypeError(f"must be a distance above 0 and at most 10 m, got {value:g}")
-    return value
+    return _bounded_float(text, 0.0, 10.0, False, "a distance above 0 and at most 10 m")
 
 
 def input_file(text: str) -> str:

@@ -81,10 +81,8 @@ def test_ablation_on_a_tiny_budget(tmp_path):
 
 def test_experiment_cli_checks_its_arguments(tmp_path):
     assert main(["experiment", "real-protocol", "--robot", "jackal", "--out", str(tmp_path)]) == 2
-    with pytest.raises(SystemExit):
-        main(["experiment", "nonsense"])
-    with pytest.raises(SystemExit):
-        main(["experiment", "sim", "--episodes", "many"])
+    assert main(["experiment", "nonsense"]) == 2
+    assert main(["experiment", "sim", "--episodes", "many"]) == 2
 
 
 @pytest.mark.parametrize("method", ["lbgp", "hc", "e2e"])

@@ -84,6 +84,7 @@ def test_kill_mid_run_then_resume_continues_from_the_checkpoint(tmp_path):
     assert len(resumed.replay) == len(saved["replay"]["ret"])
     assert all(r["env_steps"] <= saved["env_steps"] for r in read_curve(run / "r" / "curve.csv"))
     assert resumed.restarts == saved["restarts"] + 1
+    resumed.close()  # a Trainer holds its folder (run.lock) until it has run or is closed
 
     # and it really continues: run a little more through the CLI's --resume
     target = saved["env_steps"] + 150

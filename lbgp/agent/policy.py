@@ -73,11 +73,14 @@ def load_policy(path) -> Policy:
     expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
         actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]))
-        actor.load_state_dict(data["actor"])
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}
-    except (RuntimeError, KeyError, TypeError, ValueError, AttributeError) as exc:
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise ValueError(f"{path}: malformed policy file, expected {expected} ({type(exc).__name__}: {exc})") from None
+    try:
+        actor.load_state_dict(data["actor"])
+    except (RuntimeError, KeyError, TypeError, AttributeError) as exc:
         reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:120]
-        raise ValueError(f"{path}: malformed policy file, expected {expected} ({type(exc).__name__}: {reason})") from None
+        raise ValueError(f"{path}: actor weights do not match the stored sizes, expected {expected} ({reason})") from None
     if int(data["action_size"]) != 2:
         raise ValueError(f"{path}: policy has {data['action_size']} outputs, expected {expected}")
     return Policy(actor, data["method"], meta)

@@ -277,6 +277,10 @@ class Trainer:
         finally:
             self.lock.release()
 
+    def close(self) -> None:
+        """Give the run folder back (its lock) without running: ``run`` does this itself."""
+        self.lock.release()
+
     def _on_sigterm(self, signum, frame):
         raise Stop()
 

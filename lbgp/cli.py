@@ -204,7 +204,7 @@ def cmd_experiment(args) -> int:
         from lbgp.experiments.sim_table import run_sim_table
 
         run_sim_table(args.out, episodes=args.episodes, seed=args.seed, scenarios=args.scenarios, policies=policies,
-                      horizon=args.horizon, command=command)
+                      horizon=args.horizon, command=command, obs_noise=not args.no_noise)
         print(Path(args.out, "sim_table.md").read_text())
     elif args.which == "real-protocol":
         from lbgp.experiments.real_protocol import run_real_protocol
@@ -299,7 +299,8 @@ def build_parser() -> argparse.ArgumentParser:
         q.add_argument("--lbgp-policy", type=A.input_file, help="LBGP policy file (default: the shipped one)")
         q.add_argument("--e2e-policy", type=A.input_file, help="E2E policy file (default: the shipped one)")
         if name == "sim":
-            q.add_argument("--episodes", type=A.positive_int, default=5, help="seeded episodes per scenario and method")
+            q.add_argument("--episodes", type=A.positive_int, default=20, help="seeded episodes per scenario and method (default 20)")
+            q.add_argument("--no-noise", action="store_true", help="switch the observation noise off (default: the paper's noise on)")
             q.add_argument("--horizon", type=A.positive_int, default=35, help="agent steps per episode")
             q.add_argument("--scenarios", type=_names, help="comma-separated subset of the 9 scenarios")
         if name == "real-protocol":

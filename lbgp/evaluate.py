@@ -2,7 +2,7 @@
 
 The JSON written by ``lbgp evaluate --json`` is a list with one entry per scenario:
 ``scenario, method, distance_mean, distance_std (m), alpha_mean_deg, alpha_std_deg, reward (mean
-accumulated reward per episode), reward_std, collisions, terminated_early (episode counts),
+accumulated reward per episode), reward_std, reward_ci95 (half-width of the 95 % interval of the mean), collisions, terminated_early (episode counts),
 steps (mean episode length), episodes, loops (episodes in which the robot's heading turned
 through more than 180 degrees relative to the person's while its goal stayed ahead of the person:
 see ``lbgp.metrics.LoopDetector``)``.
@@ -30,10 +30,16 @@ def resolve_names(spec: str) -> list[str]:
 
 
 def evaluate(policy, method: str, names: list[str], robot: str = "jackal", episodes: int = 10, seed: int = 0,
-             recorder=None, person_path=None, horizon: int = 35) -> list[dict]:
+             recorder=None, person_path=None, horizon: int = 35, obs_noise: bool | None = None) -> list[dict]:
+    """Episode i of scenario k is seeded with (seed, k, i): every method faces the same episodes.
+    ``obs_noise``: the observation noise on/off (default: on for levels, off for scenarios)."""
     results = []
     for k, name in enumerate(names):
-        env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path, horizon=horizon)
-        runs = [run_episode(env, policy, recorder, episode_index=i) for i in range(episodes)]
+        env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path,
+                       horizon=horizon, obs_noise=obs_noise)
+        runs = []
+        for i in range(episodes):
+            env.reseed([seed, k, i])
+            runs.append(run_episode(env, policy, recorder, episode_index=i))
         results.append({"scenario": name, "method": method, **aggregate(runs)})
     return results

@@ -95,6 +95,17 @@ def goal_ahead_of_person(goal, person_pose) -> bool:
     return c * (float(goal[0]) - float(person_pose[0])) + s * (float(goal[1]) - float(person_pose[1])) > 0.0
 
 
+def reward_ci95(rewards) -> float:
+    """Half-width of the 95 % confidence interval of the mean episode reward (Student's t); NaN
+    with fewer than two episodes, 0 when every episode scored the same."""
+    r = np.asarray(rewards, dtype=float)
+    if r.size < 2:
+        return math.nan
+    from scipy import stats
+
+    return float(stats.t.ppf(0.975, r.size - 1) * r.std(ddof=1) / math.sqrt(r.size))
+
+
 def aggregate(episodes: list[EpisodeMetrics]) -> dict:
     """Mean +- std over all steps of all episodes; reward = mean accumulated reward per episode."""
     d = np.concatenate([np.asarray(e.distances) for e in episodes]) if episodes else np.zeros(0)
@@ -109,6 +120,7 @@ def aggregate(episodes: list[EpisodeMetrics]) -> dict:
         "alpha_std_deg": float(a.std()) if a.size else nan,
         "reward": float(np.mean(rewards)) if rewards else nan,
         "reward_std": float(np.std(rewards)) if rewards else nan,
+        "reward_ci95": reward_ci95(rewards),
         "collisions": int(sum(e.contact for e in episodes)),
         "terminated_early": int(sum(e.terminated_early for e in episodes)),
         "loops": int(sum(e.loops > 0 for e in episodes)),  # episodes with at least one loop

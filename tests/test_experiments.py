@@ -22,14 +22,19 @@ def read_csv(path):
 
 
 def test_sim_table_on_a_tiny_budget(tmp_path):
-    rows = run_sim_table(tmp_path, episodes=1, scenarios=["straight_ahead", "turning_inside"], horizon=6)
+    rows = run_sim_table(tmp_path, episodes=3, scenarios=["straight_ahead", "turning_inside"], horizon=6)
     assert {(r["scenario"], r["method"]) for r in rows} == {(s, m) for s in ("straight_ahead", "turning_inside") for m in ("lbgp", "hc", "e2e")}
     table = read_csv(tmp_path / "sim_table.csv")
     assert len(table) == 6
     for scenario in ("straight_ahead", "turning_inside"):
         mine = [r for r in table if r["scenario"] == scenario]
-        best = max(mine, key=lambda r: float(r["reward"]))["method"]
-        assert all(r["winner_ours"] == best for r in mine)
+        assert all(r["episodes"] == "3" and float(r["reward_ci95"]) >= 0 for r in mine)  # noise on: seeded episodes
+        best = max(mine, key=lambda r: float(r["reward"]))
+        others = [r for r in mine if r is not best]
+        separate = all(float(best["reward"]) - float(best["reward_ci95"]) > float(r["reward"]) + float(r["reward_ci95"]) for r in others)
+        assert all(r["winner_ours"] == (best["method"] if separate else "tie") for r in mine)
+        assert 0 < float(mine[0]["ceiling"]) <= 6 * 0.75 + 1e-9  # 6 steps of at most 0.75
+        assert all(float(r["reward"]) <= float(r["ceiling"]) + 1e-9 for r in mine)
         assert all(r["winner_paper"] == max(paper.SIM[scenario], key=lambda m: paper.SIM[scenario][m][4]) for r in mine)
         lbgp = next(r for r in mine if r["method"] == "lbgp")
         assert float(lbgp["paper_reward"]) == paper.SIM[scenario]["lbgp"][4]
@@ -96,3 +101,46 @@ def test_each_method_runs_every_scenario_for_a_short_seeded_episode(method):
     for r in rows:
         assert r["method"] == method and 1 <= r["steps"] <= 4
         assert np.isfinite(r["distance_mean"]) and np.isfinite(r["reward"])
+
+
+# ---------------------------------------------------------------- honest evaluation
+def test_winner_only_where_the_confidence_intervals_separate():
+    from lbgp.experiments.tables import TIE, winner
+
+    assert winner({"lbgp": 10.0, "hc": 8.0}, {"lbgp": 0.5, "hc": 0.5}) == "lbgp"
+    assert winner({"lbgp": 10.0, "hc": 9.2}, {"lbgp": 0.5, "hc": 0.5}) == TIE
+    assert winner({"lbgp": 10.0, "hc": 8.0}, {"lbgp": float("nan"), "hc": 0.5}) == TIE  # one episode: no ranking
+    assert winner({"lbgp": 10.0, "hc": 8.0}) == "lbgp"  # without intervals: the best mean
+
+
+def test_reward_confidence_interval_is_students_t():
+    from lbgp.metrics import reward_ci95
+
+    assert np.isnan(reward_ci95([3.0]))
+    assert reward_ci95([2.0, 2.0, 2.0]) == 0.0
+    # n = 4, sample std 1.2910, t(0.975, 3) = 3.1824
+    assert reward_ci95([1.0, 2.0, 3.0, 4.0]) == pytest.approx(3.1824 * 1.29099 / 2.0, rel=1e-4)
+
+
+def test_every_method_faces_the_same_seeded_episodes():
+    """Episode i is seeded on its own: what an earlier episode consumed does not change it."""
+    from lbgp.evaluate import evaluate
+    from lbgp.rollout import ConstantGoalPolicy
+
+    noisy = dict(robot="jackal", episodes=3, seed=7, horizon=4, obs_noise=True)
+    full = evaluate(ConstantGoalPolicy(), "scripted", ["straight"], **noisy)[0]
+    again = evaluate(ConstantGoalPolicy(), "scripted", ["straight"], **noisy)[0]
+    assert full["reward"] == again["reward"] and full["reward_std"] > 0  # random spawns differ per episode
+    hc = evaluate(make_policy("hc"), "hc", ["straight"], **noisy)[0]
+    assert hc["episodes"] == 3 and not np.isnan(hc["reward_ci95"])
+
+
+def test_scenario_ceiling_is_an_upper_bound():
+    from lbgp.experiments.ceiling import scenario_ceiling
+    from lbgp.sim import make_env
+    from lbgp.rollout import run_episode
+
+    assert scenario_ceiling("straight_ahead", 1.5) == pytest.approx(35 * 0.75)  # starts at the optimum, can stay there
+    bound = scenario_ceiling("turning_inside", 1.5, steps=10)
+    got = run_episode(make_env("turning_inside", robot="jackal", seed=0, horizon=10), make_policy("hc")).total_reward
+    assert got <= bound + 1e-9 and bound < 10 * 0.75

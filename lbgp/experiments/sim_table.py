@@ -1,7 +1,10 @@
 """``lbgp experiment sim``: the paper's simulation table, the 9 settings x 3 methods (Jackal).
 
-Every method runs the same seeded episodes of each scenario (``lbgp evaluate`` underneath); the
-table puts the paper's numbers beside ours and names the winner per row by accumulated reward.
+Every method runs the same seeded episodes of each scenario (``lbgp evaluate`` underneath, 20 by
+default, with the paper's observation noise); the table puts the paper's numbers beside ours, each
+row's reward ceiling (``lbgp.experiments.ceiling``) and each method's share of it, and names the
+winner per row by accumulated reward only where the 95 % confidence intervals separate ("tie"
+otherwise).
 One PNG per scenario shows the first episode of each method from above.
 """
 
@@ -10,6 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from lbgp.evaluate import evaluate
+from lbgp.experiments.ceiling import scenario_ceiling
+from lbgp.planner import planner_config_for
 from lbgp.experiments import paper
 from lbgp.experiments.tables import write_tables
 from lbgp.policies import make_policy
@@ -19,8 +24,8 @@ from lbgp.viz.trajectory_plot import TrajectoryCollector, plot_trajectories
 METHODS = ("lbgp", "hc", "e2e")
 
 
-def run_sim_table(out_dir="results", episodes: int = 5, seed: int = 0, scenarios=None, methods=METHODS, policies=None,
-                  horizon: int = 35, command: str = "") -> list[dict]:
+def run_sim_table(out_dir="results", episodes: int = 20, seed: int = 0, scenarios=None, methods=METHODS, policies=None,
+                  horizon: int = 35, command: str = "", obs_noise: bool = True) -> list[dict]:
     """Evaluate, write ``sim_table.md``, ``sim_table.csv`` and ``figures/sim_<scenario>.png``; returns the rows."""
     out_dir = Path(out_dir)
     scenarios = list(scenarios or SCENARIOS)
@@ -32,15 +37,20 @@ def run_sim_table(out_dir="results", episodes: int = 5, seed: int = 0, scenarios
             collector = TrajectoryCollector()
             # the seed depends on the scenario only, so that all methods face the same episodes
             (row,) = evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * k,
-                              recorder=collector, horizon=horizon)
+                              recorder=collector, horizon=horizon, obs_noise=obs_noise)
             rows.append(row)
             pictures[name][method.upper()] = collector.episodes[0]
     for name, panels in pictures.items():
         plot_trajectories(panels, out_dir / "figures" / f"sim_{name}.png", title=f"{name} (Jackal, first seeded episode)")
+    vmax = planner_config_for("jackal").max_vel_x
+    ceilings = {name: scenario_ceiling(name, vmax, steps=horizon) for name in scenarios}
     preamble = (f"Jackal, {episodes} seeded episodes of {horizon} agent steps (0.2 s) per scenario and method, the same "
-                f"episodes for every method. D in m, alpha in degrees (0 = straight in front), reward = mean accumulated "
-                f"reward per episode (the paper's episodes are longer, so compare rankings, not absolute rewards).\n\n"
+                f"episodes (seeds) for every method, observation noise {'on (the paper' + chr(39) + 's)' if obs_noise else 'off'}. "
+                f"D in m, alpha in degrees (0 = straight in front), reward = mean accumulated reward per episode with the "
+                f"half-width of its 95 % confidence interval (the paper's episodes are longer, so compare rankings, not "
+                f"absolute rewards). Ceiling: the best return of a relaxed point robot at the planner's {vmax} m/s from the "
+                f"scenario's start (lbgp.experiments.ceiling), an upper bound for any method.\n\n"
                 f"Made by: `{command or 'lbgp experiment sim'}`")
     write_tables(rows, ["scenario"], paper.SIM, out_dir / "sim_table.md", out_dir / "sim_table.csv",
-                 "Simulation experiment (paper Table: simulation metrics)", preamble)
+                 "Simulation experiment (paper Table: simulation metrics)", preamble, ceilings=ceilings)
     return rows

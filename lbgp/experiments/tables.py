@@ -12,15 +12,31 @@ from lbgp.files import write_text
 METHOD_NAMES = {"lbgp": "LBGP", "hc": "HC", "e2e": "E2E"}
 
 
-def winner(rewards: dict) -> str:
-    """The method with the highest reward (None and NaN never win)."""
+TIE = "tie"
+
+
+def winner(rewards: dict, ci95: dict | None = None) -> str:
+    """The method with the highest reward (None and NaN never win). With confidence intervals
+    (``ci95[m]``: half-width of the 95 % interval of the mean), a method wins only where its interval
+    lies wholly above every other method's; otherwise the row is a ``tie``."""
     valid = {m: r for m, r in rewards.items() if r is not None and not math.isnan(r)}
-    return max(valid, key=valid.get) if valid else ""
+    if not valid:
+        return ""
+    best = max(valid, key=valid.get)
+    if ci95 is None:
+        return best
+    half = {m: ci95.get(m, math.nan) for m in valid}
+    if any(math.isnan(h) for h in half.values()):
+        return TIE  # fewer than two episodes: no ranking
+    low = valid[best] - half[best]
+    return best if all(low > valid[m] + half[m] for m in valid if m != best) else TIE
 
 
 def _fmt_ours(row: dict) -> tuple[str, str, str]:
+    ci = row.get("reward_ci95", math.nan)
+    reward = f"{row['reward']:.2f}" + (f" ± {ci:.2f}" if not math.isnan(ci) else "")
     return (f"{row['distance_mean']:.2f} ± {row['distance_std']:.2f}", f"{row['alpha_mean_deg']:.1f} ± {row['alpha_std_deg']:.1f}",
-            f"{row['reward']:.2f}")
+            reward)
 
 
 def _fmt_paper(p) -> tuple[str, str, str]:
@@ -29,44 +45,53 @@ def _fmt_paper(p) -> tuple[str, str, str]:
     return f"{p[0]:.2f} ± {p[1]:.1f}", f"{p[2]:.1f} ± {p[3]:.1f}", f"{p[4]:.2f}"
 
 
-def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: Path, out_csv: Path, title: str, preamble: str) -> None:
+def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: Path, out_csv: Path, title: str, preamble: str,
+                 ceilings: dict | None = None) -> None:
     """``rows``: one dict per (group, method) with the evaluation keys; ``paper[group][method]``
-    the paper's tuple (or None = failed). Winner per group by our reward and by the paper's."""
+    the paper's tuple (or None = failed). Winner per group by our reward, only where the 95 %
+    intervals separate (else "tie"), and by the paper's. ``ceilings[group]``: the reward ceiling,
+    shown with each method's share of it."""
+    ceilings = ceilings or {}
     groups: dict = {}
     for r in rows:
         groups.setdefault(tuple(r[k] for k in group_keys), {})[r["method"]] = r
     md = io.StringIO()
     md.write(f"# {title}\n\n{preamble}\n\n")
-    md.write(f"| {' | '.join(group_keys)} | method | D ours | alpha ours (deg) | reward ours | collisions / early ends | "
-             "D paper | alpha paper | reward paper |\n")
-    md.write("|" + "---|" * (len(group_keys) + 8) + "\n")
+    md.write(f"| {' | '.join(group_keys)} | method | D ours | alpha ours (deg) | reward ours (mean ± 95 % CI) | share of ceiling | "
+             "collisions / early ends | D paper | alpha paper | reward paper |\n")
+    md.write("|" + "---|" * (len(group_keys) + 9) + "\n")
     summary = []
     csv_rows = []
     for key, by_method in groups.items():
         paper_group = paper.get(key if len(key) > 1 else key[0], {})
-        ours_best = winner({m: r["reward"] for m, r in by_method.items()})
+        ours_best = winner({m: r["reward"] for m, r in by_method.items()}, {m: r.get("reward_ci95", math.nan) for m, r in by_method.items()})
+        ceiling = ceilings.get(key if len(key) > 1 else key[0])
         paper_best = winner({m: (p[4] if p else None) for m, p in paper_group.items()})
         for method, r in by_method.items():
             d, a, rew = _fmt_ours(r)
             pd, pa, prew = _fmt_paper(paper_group.get(method)) if method in paper_group else ("", "", "")
             bold = (lambda s, m=method, b=ours_best: f"**{s}**" if m == b else s)
             pbold = (lambda s, m=method, b=paper_best: f"**{s}**" if m == b and s not in ("", "Failed") else s)
-            md.write(f"| {' | '.join(map(str, key))} | {METHOD_NAMES.get(method, method)} | {d} | {a} | {bold(rew)} | "
+            share = f"{r['reward'] / ceiling:.0%} of {ceiling:.1f}" if ceiling else ""
+            md.write(f"| {' | '.join(map(str, key))} | {METHOD_NAMES.get(method, method)} | {d} | {a} | {bold(rew)} | {share} | "
                      f"{r['collisions']} / {r['terminated_early']} | {pd} | {pa} | {pbold(prew)} |\n")
             p = paper_group.get(method)
             csv_rows.append({**{k: v for k, v in zip(group_keys, key)}, "method": method,
-                             **{k: r[k] for k in ("distance_mean", "distance_std", "alpha_mean_deg", "alpha_std_deg", "reward",
-                                                  "reward_std", "collisions", "terminated_early", "steps", "episodes")},
+                             **{k: r.get(k, "") for k in ("distance_mean", "distance_std", "alpha_mean_deg", "alpha_std_deg", "reward",
+                                                          "reward_std", "reward_ci95", "collisions", "terminated_early", "loops",
+                                                          "steps", "episodes")},
+                             "ceiling": ceiling if ceiling else "",
                              "paper_distance_mean": p[0] if p else "", "paper_alpha_mean_deg": p[2] if p else "",
                              "paper_reward": p[4] if p else ("failed" if method in paper_group else ""),
                              "winner_ours": ours_best, "winner_paper": paper_best})
         summary.append((key, ours_best, paper_best))
-    md.write("\n## Winner per row (by accumulated reward)\n\n| " + " | ".join(group_keys) + " | ours | paper |\n|"
+    md.write("\n## Winner per row (by accumulated reward; ours only where the 95 % intervals separate)\n\n| " + " | ".join(group_keys) + " | ours | paper |\n|"
              + "---|" * (len(group_keys) + 2) + "\n")
     for key, ours_best, paper_best in summary:
         md.write(f"| {' | '.join(map(str, key))} | {METHOD_NAMES.get(ours_best, ours_best)} | {METHOD_NAMES.get(paper_best, paper_best)} |\n")
     lbgp_wins = sum(1 for _, o, _ in summary if o == "lbgp")
-    md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here (the paper: "
+    ties = sum(1 for _, o, _ in summary if o == TIE)
+    md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here, {ties} are ties (the paper: "
              f"{sum(1 for _, _, p in summary if p == 'lbgp')} of {len(summary)}).\n")
     _atomic_text(out_md, md.getvalue())
     buf = io.StringIO()

@@ -98,6 +98,12 @@ class FollowAheadEnv(dm_env.Environment):
     def reward_spec(self):
         return dm_env.specs.BoundedArray((), float, -1.0, 1.0, name="reward")
 
+    def reseed(self, seed) -> None:
+        """Seed the next episodes (spawn, person motion, observation noise) afresh: evaluation gives
+        every episode its own seed, so that all methods face the same episodes whatever their
+        earlier episodes consumed."""
+        self.task.rng = np.random.default_rng(seed)
+
     # -- extras for metrics, plots and tests (not for the policy)
     def info(self) -> dict:
         return self.task.info(self.physics)

@@ -99,7 +99,7 @@ def test_the_planner_period_reaches_the_acceleration_clamp(period):
 
     planner.plan = spy
     for _ in range(5):
-        ts = env.step(np.array([1.0, 0.0]))  # a goal far ahead: accelerate as hard as allowed
+        env.step(np.array([1.0, 0.0]))  # a goal far ahead: accelerate as hard as allowed
     step = np.abs(np.array(commands)[:, 0] - np.array(velocities)[:, 0])
     assert step.max() <= limits.acc_lim_x * period + 1e-9
     assert step.max() > 0.5 * limits.acc_lim_x * period  # it does accelerate

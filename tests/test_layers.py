@@ -86,7 +86,7 @@ def test_the_planner_period_reaches_the_acceleration_clamp(period):
     env = make_env("straight_ahead", robot="jackal", seed=0, planner_period=period)
     limits = env.task.limits
     assert limits.control_period == period
-    ts = env.reset()
+    env.reset()
     velocities, commands = [], []
     planner = env.task.controller.planner
     original = planner.plan

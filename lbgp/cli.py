@@ -8,13 +8,8 @@ import sys
 from pathlib import Path
 
 from lbgp import cli_args as A
+from lbgp.files import write_json
 from lbgp.policies import default_policy_path
-
-
-def _write_json_atomic(path: Path, data) -> None:
-    from lbgp.files import write_json
-
-    write_json(path, data)
 
 
 def _print_table(rows: list[dict]) -> None:
@@ -55,7 +50,7 @@ def cmd_demo(args) -> int:
             rows.append(run_episode(env, policy, recorder, episode_index=i).summary())
     _print_table(rows)
     summary = {"robot": args.robot, "seed": args.seed, "policy": policy_name, "episodes": rows}
-    _write_json_atomic(out / "summary.json", summary)
+    write_json(out / "summary.json", summary)
     print(f"wrote {out / 'demo.rrd'} (open with: rerun {out / 'demo.rrd'}) and {out / 'summary.json'}")
     return 0
 
@@ -83,7 +78,7 @@ def cmd_evaluate(args) -> int:
         print(f"{r['scenario']:<18}{r['distance_mean']:>7.2f}+-{r['distance_std']:<5.2f}{r['alpha_mean_deg']:>9.1f}+-{r['alpha_std_deg']:<6.1f}"
               f"{r['reward']:>9.2f}{r['collisions']:>6d}{r['terminated_early']:>6d}{r['steps']:>7.1f}")
     if args.json:
-        _write_json_atomic(Path(args.json), results)
+        write_json(Path(args.json), results)
     return 0
 
 
@@ -159,7 +154,7 @@ def cmd_deploy(args) -> int:
         summary["error"] = f"{type(loop.error).__name__}: {loop.error}"
     print(json.dumps(summary, indent=2))
     if args.json:
-        _write_json_atomic(Path(args.json), summary)
+        write_json(Path(args.json), summary)
     if loop.error is not None:
         print(f"lbgp deploy: error: {summary['error']} (a zero command was sent)", file=sys.stderr)
         return 1
@@ -193,7 +188,7 @@ def cmd_replay(args) -> int:
     summary = {"log": args.log, "truncated": log["truncated"], "metadata": log["metadata"], **metrics.summary()}
     print(json.dumps(summary, indent=2))
     if args.json:
-        _write_json_atomic(Path(args.json), summary)
+        write_json(Path(args.json), summary)
     return 0
 
 

@@ -46,9 +46,6 @@ class Stop(Exception):
     """Raised by the SIGTERM handler so that the run checkpoints and stops cleanly."""
 
 
-_write_json = write_json
-
-
 def read_curve(path: str | os.PathLike) -> list[dict]:
     """Rows of a curve.csv; a half-written last line (killed run) is ignored."""
     rows = []
@@ -304,7 +301,7 @@ class Trainer:
             "interrupted": interrupted,
         }
         save_policy(self.dir / "policy.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden, extra=summary)
-        _write_json(self.dir / "summary.json", summary)
+        write_json(self.dir / "summary.json", summary)
         return summary
 
 

@@ -93,13 +93,11 @@ def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: P
     ties = sum(1 for _, o, _ in summary if o == TIE)
     md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here, {ties} are ties (the paper: "
              f"{sum(1 for _, _, p in summary if p == 'lbgp')} of {len(summary)}).\n")
-    _atomic_text(out_md, md.getvalue())
+    write_text(out_md, md.getvalue())
     buf = io.StringIO()
     if csv_rows:
         w = csv.DictWriter(buf, fieldnames=list(csv_rows[0]))
         w.writeheader()
         w.writerows(csv_rows)
-    _atomic_text(out_csv, buf.getvalue())
+    write_text(out_csv, buf.getvalue())
 
-
-_atomic_text = write_text

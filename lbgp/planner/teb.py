@@ -216,14 +216,14 @@ class TebPlanner:
                 if best is not None:
                     continue  # an extra candidate that failed is just not a candidate
                 return self._stop(v_now, w_now, status, t_start, None, problem, iterations)
-            cost = self._candidate_score(problem, u)
+            poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
+            clearance = self._clearance(problem, poses)
+            cost = self._candidate_score(problem, u, poses, clearance)
             if best is None or cost < best[0] - 1e-9:
-                best = (cost, u, name)
-            if name != "wait" and cfg.wait_candidate and self._near_person(problem, u):
-                candidates.append("wait")  # the person's path is near this band: also try letting them pass
-        _, u, name = best
-        poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
-        clearance = np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T)
+                best = (cost, u, name, poses, clearance)
+            if name != "wait" and cfg.wait_candidate and clearance.min() < cfg.safety_distance + cfg.wait_margin:
+                candidates.append("wait")  # the band passes near the person's path: also try letting them pass
+        _, u, name, poses, clearance = best
         now = float(np.hypot(*(robot_pose[:2] - person_pose[:2])))
         if clearance[0] < cfg.safety_distance - cfg.clearance_tolerance and clearance[0] < now:
             return self._stop(v_now, w_now, INFEASIBLE, t_start, poses, problem, iterations)
@@ -248,11 +248,11 @@ class TebPlanner:
         lower[:M] = np.minimum(0.0, reachable)
         return lower
 
-    def _near_person(self, problem: _Problem, u: np.ndarray) -> bool:
-        """Whether the band driven by ``u`` comes within ``wait_margin`` of the safety distance."""
-        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
-        clearance = np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T)
-        return bool(clearance.min() < self.cfg.safety_distance + self.cfg.wait_margin)
+    @staticmethod
+    def _clearance(problem: _Problem, poses: np.ndarray) -> np.ndarray:
+        """Distance of band poses 1..M from the person's predicted position at their times."""
+        diff = poses[1:, :2] - problem.person_path[1:]
+        return np.hypot(diff[:, 0], diff[:, 1])
 
     def _over_budget(self, t_start: float, iterations: int) -> bool:
         budget = self.cfg.sqp_time_budget
@@ -291,7 +291,8 @@ class TebPlanner:
         self._times = h * np.arange(self.N)
         # tracking weight grows along the band (ramp from weight_track_start to weight_track): the
         # robot is asked to be on the goal's path later, not at once, so it converges smoothly
-        track = cfg.weight_track * np.linspace(cfg.weight_track_start, 1.0, M)
+        ramp = np.linspace(cfg.weight_track_start, 1.0, M)
+        track = cfg.weight_track * ramp
         track[-1] += cfg.weight_goal
         self._w_track = np.concatenate([track, track])
         # constant residual rows on the commands: v changes, w changes, w (and the last heading,
@@ -306,7 +307,7 @@ class TebPlanner:
         P = np.zeros((n, n))
         P[X : X + M, X : X + M] = np.diag(2.0 * track)
         P[Y : Y + M, Y : Y + M] = np.diag(2.0 * track)
-        heading = cfg.weight_heading_track * np.linspace(cfg.weight_track_start, 1.0, M)
+        heading = cfg.weight_heading_track * ramp
         heading[-1] += cfg.weight_goal_heading
         self._w_heading = heading
         P[TH + np.arange(M), TH + np.arange(M)] = 2.0 * heading
@@ -361,16 +362,15 @@ class TebPlanner:
         heading = wrap_angle(poses[1:, 2] - problem.goal_yaw)
         return track, heading, np.concatenate([np.diff(v, prepend=problem.v_ref), np.diff(w, prepend=problem.w_ref), w])
 
-    def _candidate_score(self, problem: _Problem, u: np.ndarray) -> float:
+    def _candidate_score(self, problem: _Problem, u: np.ndarray, poses: np.ndarray, clearance: np.ndarray) -> float:
         """How candidate bands are ranked: the objective's position, command and clearance terms
         over the band (not the headings along it: turning around costs heading on the way), plus
         what the band leaves undone, ``weight_time_to_go`` times the time to cover the remaining
         distance to the goal at the speed the band's last pose allows towards it (forwards if the
         goal is in front of it, backwards otherwise) and to turn to the goal's heading there."""
         cfg = self.cfg
-        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
         track, heading, const = self._residuals(problem, u, poses)
-        violation = np.maximum(cfg.safety_distance - np.hypot(*(poses[1:, :2] - problem.person_path[1:]).T), 0.0)
+        violation = np.maximum(cfg.safety_distance - clearance, 0.0)
         end = poses[-1]
         d = problem.goal_path[-1] - end[:2]
         ahead = math.cos(end[2]) * d[0] + math.sin(end[2]) * d[1]
@@ -413,7 +413,7 @@ class TebPlanner:
         hi[M:] = np.minimum(hi[M:], cap)
         return lo, hi
 
-    def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray | None = None, upper: np.ndarray | None = None):
+    def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, upper: np.ndarray):
         cfg, M, h = self.cfg, self.M, self.h
         v, w = u[:M], u[M:]
         poses = rollout(problem.pose0, v, w, h)
@@ -425,9 +425,8 @@ class TebPlanner:
         A[self._kin_at] = np.concatenate([
             -h * c, 0.5 * h * hv * s, -h * s, -0.5 * h * hv * c, hv[1:] * s[1:], -hv[1:] * c[1:],
         ])
-        diff = poses[1:, :2] - problem.person_path[1:]
-        dist = np.hypot(diff[:, 0], diff[:, 1])
-        normal = diff / np.maximum(dist, 1e-9)[:, None]
+        dist = self._clearance(problem, poses)
+        normal = (poses[1:, :2] - problem.person_path[1:]) / np.maximum(dist, 1e-9)[:, None]
         A[self._clear_at] = normal.T.ravel()
         q = self._q
         track, heading, const = self._residuals(problem, u, poses)
@@ -435,8 +434,8 @@ class TebPlanner:
         q[2 * M : 3 * M] = 2.0 * self._w_heading * heading
         q[3 * M : 5 * M] = 2.0 * self._Jc.T @ (self._w_const * const)
         lo, hi = self._lo, self._hi
-        lo[3 * M : 5 * M] = np.maximum((self._u_lo if lower is None else lower) - u, -self._trust)
-        hi[3 * M : 5 * M] = np.maximum(np.minimum((self._u_hi if upper is None else upper) - u, self._trust), lo[3 * M : 5 * M])
+        lo[3 * M : 5 * M] = np.maximum(lower - u, -self._trust)
+        hi[3 * M : 5 * M] = np.maximum(np.minimum(upper - u, self._trust), lo[3 * M : 5 * M])
         dv = np.diff(v, prepend=problem.v_ref)
         dw = np.diff(w, prepend=problem.w_ref)
         lo[6 * M : 7 * M], hi[6 * M : 7 * M] = -self._acc_v - dv, self._acc_v - dv

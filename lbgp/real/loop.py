@@ -49,6 +49,8 @@ class StopRequested(KeyboardInterrupt):
     def __init__(self, signal_name: str):
         super().__init__(signal_name)
         self.signal_name = signal_name
+
+
 DEPLOY_DEFAULT_BUDGET = 0.002  # s of SQP per planner call in ``lbgp deploy`` (see docs/deploy.md, "Latency")
 
 
@@ -149,9 +151,11 @@ class DeployLoop:
         status = self.monitor.update(frames, now)
         frame = self.monitor.last
         record = TickRecord(now, status, 0.0, 0.0)
+        # first data, or back after a long gap (the source's clock may have restarted): start afresh
+        resumed = now - self._last_good > self.cfg.safety.reanchor_after
         if status == safety_lib.OK:
-            if now - self._last_good > self.cfg.safety.reanchor_after:
-                self._people.clear()  # first data, or back after a long gap (the source's clock may have restarted)
+            if resumed:
+                self._people.clear()
             if not self._people or self._people[-1][0] < frame.t:
                 self._people.append((frame.t, frame.person.copy()))
             record.robot, record.person = frame.robot.copy(), frame.person.copy()
@@ -160,7 +164,7 @@ class DeployLoop:
                 status = record.status = safety_lib.TOO_CLOSE
         if status == safety_lib.OK:
             state = WorldState(frame.t, frame.robot.copy(), np.array(self.command), frame.person.copy(), *self._person_motion(frame))
-            if now - self._last_good > self.cfg.safety.reanchor_after:  # first data, or back after a long gap
+            if resumed:
                 self.stack.reset(state.robot_pose, state.person_pose)
                 self.controller.reset()
                 if hasattr(self.policy, "reset"):

@@ -23,6 +23,7 @@ import time
 
 import numpy as np
 
+from lbgp.conventions import DESIRED_DISTANCE
 from lbgp.real.frames import PoseFrame, encode_frame
 from lbgp.real.udp import UdpCommandListener, sending_socket
 from lbgp.sim import tasks
@@ -48,7 +49,7 @@ class SimWorld:
     def __init__(self, setting="straight_ahead", robot: str = "turtlebot2", seed: int = 0, person_path=None, spawn=None):
         spec = get_robot(robot)
         if person_path is not None:
-            setting = tasks.path_setting(person_path, spawn=spawn or (1.5, 0.0))
+            setting = tasks.path_setting(person_path, spawn=spawn or (DESIRED_DISTANCE, 0.0))
         elif isinstance(setting, str):
             setting = tasks.get_setting(setting)
         self.spec = spec

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dm_env
 import numpy as np
 
-from lbgp.conventions import DESIRED_GOAL, PLANNER_PERIOD
+from lbgp.conventions import DESIRED_DISTANCE, PLANNER_PERIOD
 from lbgp.robots import get_robot
 from lbgp.sim import tasks
 
@@ -143,7 +143,7 @@ def make_env(
     """
     setting = tasks.get_setting(level)
     if person_path is not None:
-        spawn = setting.spawn if setting.spawn is not None else DESIRED_GOAL
+        spawn = setting.spawn if setting.spawn is not None else (DESIRED_DISTANCE, 0.0)
         setting = tasks.path_setting(person_path, spawn=spawn)
     spec = get_robot(robot)
     physics = tasks.load_physics(spec)

@@ -23,7 +23,7 @@ from _common import write_result  # noqa: E402
 from test_learning import NetworkPolicy, RandomPolicy, straight_ahead_return, straight_level_config  # noqa: E402
 
 from lbgp.agent import load_policy  # noqa: E402
-from lbgp.agent.networks import Actor  # noqa: E402
+from lbgp.agent.learner import make_actor  # noqa: E402
 from lbgp.agent.train import train  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 
@@ -31,7 +31,7 @@ from lbgp.sim import observation as obs_lib  # noqa: E402
 def one_seed(seed: int) -> dict:
     cfg = straight_level_config(seed=seed, total_steps=10_000)
     torch.manual_seed(seed)
-    untrained = Actor(obs_lib.SIZE, 2, cfg.hidden)
+    untrained = make_actor(cfg, obs_lib.SIZE, 2)
     with tempfile.TemporaryDirectory() as tmp:
         train(cfg, Path(tmp) / "run", backend="inline", progress=False)
         trained = straight_ahead_return(load_policy(Path(tmp) / "run" / "policy.pt"))

@@ -69,7 +69,7 @@ def cmd_evaluate(args) -> int:
         recorder = EpisodeRecorder(args.record, spawn=args.spawn)
     try:
         results = evaluate(policy, args.method, names, robot=args.robot, episodes=args.episodes, seed=args.seed,
-                           recorder=recorder, person_path=args.person_path)
+                           recorder=recorder, person_path=args.person_path, dynamics=args.dynamics)
     finally:
         if recorder is not None:
             recorder.close()
@@ -92,12 +92,17 @@ def cmd_train(args) -> int:
     else:
         if not args.out:
             raise ValueError("--out DIR is required (or --resume DIR)")
-        cfg = D4PGConfig(
+        preset = D4PGConfig.paper if args.paper else D4PGConfig
+        chosen = dict(
             method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
-            num_actors=args.actors,
-            prior_weight=D4PGConfig.prior_weight if args.prior_weight is None else args.prior_weight,
-        ).validate()
+        )
+        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "max_updates_per_step": args.updates_per_step}
+        if args.randomize:
+            from lbgp.dynamics import load_randomization
+
+            given["randomize"] = load_randomization(args.randomize).to_dict()
+        cfg = preset(**chosen, **{k: v for k, v in given.items() if v is not None}).validate()
         summary = train(cfg, args.out, backend=args.backend)
     print(json.dumps(summary, indent=2))
     return 130 if summary.get("interrupted") else 0
@@ -139,7 +144,7 @@ def cmd_deploy(args) -> int:
                       record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
                       planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
                       metadata={"method": args.method, "policy": args.policy or "default"},
-                      first_pose_timeout=args.first_pose_timeout or None,
+                      first_pose_timeout=args.first_pose_timeout or None, dynamics=args.dynamics,
                       on_open=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True),
                       on_wait=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True))
     except KeyboardInterrupt:  # before the loop ran (opening the source, the log, the viewer)
@@ -238,6 +243,49 @@ def cmd_plot_curves(args) -> int:
     return 0
 
 
+def cmd_sysid(args) -> int:
+    if args.excite:
+        return _sysid_excite(args)
+    if not args.log_file:
+        raise ValueError("name the log to fit (lbgp sysid LOG.mcap --robot ROBOT --out dynamics.json), or record one with --excite")
+    from lbgp.dynamics import save_dynamics
+    from lbgp.real.sysid import identify, plot_fit
+
+    result = identify(args.log_file, args.robot)
+    summary = result.summary()
+    print(f"lbgp sysid: {args.log_file}, robot {args.robot}, {summary['duration_s']} s of data")
+    for key, value in summary.items():
+        print(f"  {key:<18}{value}")
+    if args.out:
+        save_dynamics(Path(args.out), result.dynamics, extra={"fit": summary, "log": str(args.log_file), "robot": args.robot})
+        print(f"dynamics written to {args.out} (use: --dynamics {args.out})")
+    if args.png:
+        plot_fit(result, Path(args.png))
+        print(f"measured vs simulated velocity: {args.png}")
+    return 0
+
+
+def _sysid_excite(args) -> int:
+    import signal
+
+    from lbgp.real.sysid import record_excitation
+
+    if not args.log:
+        raise ValueError("--excite records a log: name it with --log FILE.mcap")
+    print(f"lbgp sysid --excite: ~41 s of steps and a chirp on {args.robot}, log {args.log}", flush=True)
+    previous = _stop_on_signals()
+    try:
+        loop = record_excitation(args.robot, args.log, source=args.source, sink=args.sink, dynamics=args.dynamics, seed=args.seed,
+                                 on_open=lambda msg: print(f"lbgp sysid: {msg}", file=sys.stderr, flush=True))
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if loop.error is not None:
+        raise ValueError(f"excitation stopped: {loop.error}")
+    print(f"recorded {loop.ticks} ticks ({loop.end_reason}); fit it with: lbgp sysid {args.log} --robot {args.robot} --out dynamics.json")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = A.OneLineParser(prog="lbgp", description="Learning Based Goal Planning: a robot that walks in front of a person.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, parser_class=A.OneLineParser)
@@ -264,6 +312,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", type=A.output_file, help="write a rerun recording (.rrd) of every episode")
     p.add_argument("--spawn", action="store_true", help="also open a live rerun viewer (when one is installed)")
     p.add_argument("--transfer", action="store_true", help="allow a policy file trained on another robot (zero-shot transfer)")
+    p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
+                   help="robot dynamics: nominal (default), hardware_like, or a JSON file (e.g. from lbgp sysid)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -273,9 +323,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=A.positive_int, default=None, help="environment steps in all (default 300000)")
     p.add_argument("--minutes", type=A.positive_float, default=None, help="also stop after this much wall time")
     p.add_argument("--seed", type=A.seed, default=0)
-    p.add_argument("--actors", type=A.positive_int, default=4, help="actor processes (one of them exploits)")
+    p.add_argument("--actors", type=A.positive_int, default=None, help="actor processes, one of them exploits (default 2: one per core beside the learner's on 2 cores)")
     p.add_argument("--prior-weight", type=A.nonnegative_float, default=None,
-                   help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; 0: plain D4PG)")
+                   help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; --paper: 0)")
+    p.add_argument("--updates-per-step", type=A.positive_float, default=None,
+                   help="the learner's updates per collected env step at most (default 2; --paper: 1)")
+    p.add_argument("--randomize", type=A.randomize_spec, default=None, metavar="PRESET|FILE",
+                   help="domain randomisation per episode: a preset (default, none) or a JSON file of ranges (docs/simulation.md)")
+    p.add_argument("--paper", action="store_true",
+                   help="the paper's plain D4PG configuration: tanh actor on raw inputs, white noise 0.3, uniform spawns, no goal prior")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],
                    help="processes: actor processes (default); inline: one process, reproducible; ray: Ray tasks (extra)")
     p.add_argument("--out", type=A.output_dir, help="run directory (created)")
@@ -333,7 +389,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--first-pose-timeout", type=A.nonnegative_float, default=10.0, metavar="S",
                    help="end with an error if no valid pose arrived within S seconds (default 10; 0: wait for ever)")
     p.add_argument("--json", type=A.output_file, help="write the run's summary here")
+    p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
+                   help="simulated robot only (--source sim): nominal (default), hardware_like, or a JSON file")
     p.set_defaults(func=cmd_deploy)
+
+    p = sub.add_parser("sysid", help="identify a robot's dynamics from a deploy log (or --excite: record one)")
+    p.add_argument("log_file", nargs="?", type=A.input_file, help="an lbgp MCAP log (from lbgp deploy --log or --excite)")
+    p.add_argument("--robot", default="turtlebot2", choices=["jackal", "turtlebot2"])
+    p.add_argument("--out", type=A.output_file, help="write the fitted dynamics here (JSON, for --dynamics)")
+    p.add_argument("--png", type=A.output_file, help="plot of measured vs simulated velocity")
+    p.add_argument("--excite", action="store_true", help="drive a safe excitation sequence (steps, chirp; safety stops on) and log it")
+    p.add_argument("--log", type=A.output_file, help="--excite: the MCAP log to write")
+    p.add_argument("--source", default=None, help="--excite: pose source (default: the simulator, person standing 6 m away)")
+    p.add_argument("--sink", default=None, help="--excite: command sink (default: the simulator's)")
+    p.add_argument("--dynamics", type=A.dynamics_spec, default=None, help="--excite in simulation: the simulated robot's dynamics")
+    p.add_argument("--seed", type=A.seed, default=0)
+    p.set_defaults(func=cmd_sysid)
 
     p = sub.add_parser("replay", help="re-play an lbgp MCAP log: metrics and a rerun recording")
     p.add_argument("log", type=A.input_file, help="the .mcap file written by lbgp deploy --log")

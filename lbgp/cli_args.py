@@ -73,6 +73,28 @@ def input_file(text: str) -> str:
     return text
 
 
+def dynamics_spec(text: str) -> str:
+    """A named dynamics set (nominal, hardware_like) or an existing JSON file of parameters."""
+    if text in ("nominal", "hardware_like"):
+        return text
+    try:
+        return input_file(text)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{exc}; use nominal, hardware_like or a JSON file of dynamics parameters") from None
+
+
+def randomize_spec(text: str) -> str:
+    """A domain-randomisation preset name or an existing JSON file of ranges."""
+    from lbgp.dynamics import RANDOMIZATION
+
+    if text in RANDOMIZATION:
+        return text
+    try:
+        return input_file(text)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{exc}; use a preset ({', '.join(RANDOMIZATION)}) or a JSON file of ranges") from None
+
+
 def _check_writable_parent(path: Path, text: str) -> None:
     parent = path.parent
     while not parent.exists():  # folders that will be created: the nearest existing one decides

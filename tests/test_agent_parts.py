@@ -193,7 +193,8 @@ def _actor_steps(method, prior_weight, steps=50):
     from lbgp.sim import observation as obs_lib
 
     torch.manual_seed(0)
-    learner = D4PGLearner(D4PGConfig(method=method, prior_weight=prior_weight, actor_lr=1e-2), obs_lib.SIZE, 2)
+    # the paper's plain actor: the residual form starts at the prior exactly (tests/test_goal_policy.py)
+    learner = D4PGLearner(D4PGConfig.paper(method=method, prior_weight=prior_weight, actor_lr=1e-2), obs_lib.SIZE, 2)
     with torch.no_grad():
         for p in learner.critic.parameters():
             p.zero_()

@@ -23,7 +23,7 @@ import torch
 
 from lbgp.agent import load_policy
 from lbgp.agent.config import D4PGConfig
-from lbgp.agent.networks import Actor
+from lbgp.agent.learner import make_actor
 from lbgp.agent.train import train
 from lbgp.rollout import run_episode
 from lbgp.sim import make_env
@@ -58,16 +58,18 @@ def straight_ahead_return(policy, episodes=2):
 
 def straight_level_config(seed: int, total_steps: int, **overrides) -> D4PGConfig:
     """Training that stays on the first curriculum level: unreachable thresholds and a budget larger
-    than the run (also used by benchmarks/learning_seeds.py and benchmarks/prior_weight_sweep.py)."""
-    return D4PGConfig(seed=seed, total_steps=total_steps, level_thresholds=(1e9, 1e9, 1e9),
-                      level_budget_fraction=(10.0, 10.0, 10.0), **overrides)
+    than the run (also used by benchmarks/learning_seeds.py and benchmarks/prior_weight_sweep.py).
+    The paper's plain actor with the goal prior: the check is that D4PG learns from a random actor
+    (the residual actor starts at the constant goal already, tests/test_goal_policy.py)."""
+    settings = dict(prior_weight=1.0, level_thresholds=(1e9, 1e9, 1e9), level_budget_fraction=(10.0, 10.0, 10.0))
+    return D4PGConfig.paper(seed=seed, total_steps=total_steps, **{**settings, **overrides})
 
 
 @pytest.mark.slow
 def test_short_training_on_the_straight_level_beats_random_and_untrained(tmp_path):
     cfg = straight_level_config(seed=0, total_steps=10_000)
     torch.manual_seed(cfg.seed)
-    untrained = Actor(obs_lib.SIZE, 2, cfg.hidden)  # the learner's initial actor (same seed, same construction)
+    untrained = make_actor(cfg, obs_lib.SIZE, 2)  # the learner's initial actor (same seed, same construction)
     summary = train(cfg, tmp_path / "run", backend="inline", progress=False)
     assert summary["final_level"] == "straight" and summary["learner_updates"] >= 9_000
 

@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 from lbgp.agent.config import D4PGConfig
+from lbgp.agent.learner import make_actor
 from lbgp.agent.networks import Actor
 from lbgp.agent.nstep import NStepAccumulator
 from lbgp.sim import observation as obs_lib
@@ -76,18 +77,34 @@ def choose_level(spec: ActorSpec, cfg: D4PGConfig, current: int, rng: np.random.
     return CURRICULUM[current]
 
 
+class ExplorationNoise:
+    """Gaussian exploration noise, white (``correlation`` 0, the paper) or AR(1) in time: n_t =
+    c n_{t-1} + sqrt(1 - c^2) sigma e_t, whose stationary std is sigma whatever c. Starts stationary."""
+
+    def __init__(self, sigma: float, correlation: float, rng: np.random.Generator):
+        self.sigma, self.c, self.rng = float(sigma), float(correlation), rng
+        self.value = self.sigma * rng.normal(size=ACTION_SIZE)
+
+    def sample(self) -> np.ndarray:
+        out = self.value
+        innovation = self.sigma * self.rng.normal(size=ACTION_SIZE)
+        self.value = self.c * self.value + np.sqrt(1.0 - self.c**2) * innovation
+        return out
+
+
 def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.random.Generator, nstep: NStepAccumulator, refresh=None):
     """One episode; returns (n-step transition batch, return, steps). ``refresh()`` is called every
     ``weight_sync_steps`` steps so that long episodes pick up new weights."""
     transitions, episode_return, steps = [], 0.0, 0
     nstep.reset()
     timestep = env.reset()
+    noise = ExplorationNoise(cfg.sigma, cfg.noise_correlation, rng)
     while not timestep.last():
         obs = timestep.observation
         with torch.no_grad():
             action = actor(torch.from_numpy(obs)[None])[0].numpy()
         if exploring:
-            action = np.clip(action + cfg.sigma * rng.normal(size=ACTION_SIZE), -1.0, 1.0).astype(np.float32)
+            action = np.clip(action + noise.sample(), -1.0, 1.0).astype(np.float32)
         timestep = env.step(action)
         episode_return += timestep.reward
         steps += 1
@@ -111,7 +128,9 @@ class EnvCache:
             from lbgp.sim import make_env
 
             cfg = self.cfg
-            self.envs[level] = make_env(level, robot=cfg.robot, seed=int(self.rng.integers(2**31)), control=cfg.control, horizon=cfg.horizon)
+            self.envs[level] = make_env(level, robot=cfg.robot, seed=int(self.rng.integers(2**31)), control=cfg.control,
+                                        horizon=cfg.horizon, spawn_front_share=cfg.spawn_front_share,
+                                        randomize=cfg.randomize or None)
         return self.envs[level]
 
 
@@ -125,7 +144,7 @@ def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, 
         queue.cancel_join_thread()  # never hang at exit on a queue nobody reads any more
     parent = mp.parent_process()
     rng = np.random.default_rng(spec.seed)
-    actor = Actor(obs_lib.SIZE, ACTION_SIZE, cfg.hidden)
+    actor = make_actor(cfg, obs_lib.SIZE, ACTION_SIZE)
     version = -1
     envs = EnvCache(cfg, rng)
     nstep = NStepAccumulator(cfg.n_step, cfg.discount)

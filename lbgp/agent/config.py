@@ -24,9 +24,14 @@ class D4PGConfig:
     time_limit_s: float = 0.0  # stop after this wall time too (0: no limit)
 
     # --- actors
-    num_actors: int = 4  # the paper: 3 exploring + 1 exploiting
+    num_actors: int = 2  # the paper: 3 exploring + 1 exploiting; on a 2-core machine the learner takes
+    # one core and one exploring + one exploiting actor the other (more actors thrash the caches)
     num_exploit: int = 1  # actors without noise; their returns are the learning curve
-    sigma: float = 0.3  # Gaussian exploration noise on the [-1, 1] action (acme)
+    sigma: float = 0.15  # Gaussian exploration noise on the [-1, 1] action (acme and the paper: 0.3, white);
+    # 0.15 = 0.3 m of goal: within the residual's +-0.75 m, an exploring goal still lands near a useful one
+    noise_correlation: float = 0.8  # AR(1) coefficient of the exploration noise per agent step (0: white,
+    # the paper). Correlated noise holds a deviation for ~1 s, long enough for the planner to act on it;
+    # white noise of 0.2 s per value mostly averages out in the robot's motion. Stationary std = sigma.
     weight_sync_steps: int = 200  # actors fetch fresh weights at least this often (agent steps)
     earlier_level_share: float = 0.2  # share of exploring episodes on an earlier curriculum level
     actor_niceness: int = 10  # actors run at lower priority: the learner keeps ~1 core on a 2-core box
@@ -34,7 +39,7 @@ class D4PGConfig:
     # --- learner
     n_step: int = 5  # (acme)
     discount: float = 0.97  # acme 0.99; 0.97 (effective horizon ~33 steps) matches 35-step episodes
-    batch_size: int = 128  # acme 256; halves the learner cost on a 2-core CPU
+    batch_size: int = 256  # (acme)
     actor_lr: float = 3e-4  # acme 1e-4; 3e-4 learns faster within the ~100k updates a 2-core budget allows
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
@@ -49,7 +54,21 @@ class D4PGConfig:
     grad_clip: float = 40.0  # global-norm clip (acme)
     replay_capacity: int = 500_000
     min_replay: int = 2_000  # learning starts after this many transitions (acme 1,000)
-    max_updates_per_step: float = 1.0  # learner never runs more updates than env steps collected
+    max_updates_per_step: float = 2.0  # the learner runs at most this many updates per env step
+    # collected (the actors are planner-bound at ~100 steps/s, the learner does ~240 updates/s at batch 256)
+
+    actor_warmup_updates: int = 5_000  # the actor stays fixed for the critic's first updates: a random
+    # critic's gradient would push a residual actor off its base goal before anything was learnt (0: paper)
+
+    # --- LBGP's goal policy (see lbgp/agent/networks.py and docs/training.md)
+    residual_scale: float = 0.375  # > 0: the actor outputs the goal 1.5 m ahead plus a residual bounded by
+    # this (action units: 0.375 = 0.75 m), its last layer initialised to zero; 0 = the paper's plain actor.
+    # E2E: always plain.
+    normalize_obs: bool = True  # standardise the observation (mean/std of the first min_replay transitions)
+    randomize: dict = dataclasses.field(default_factory=dict)  # domain randomisation ranges per episode
+    # (lbgp.dynamics.Randomization as a dict; `lbgp train --randomize PRESET|FILE` fills it); {}: none
+    spawn_front_share: float = 0.75  # share of training spawns in front of the person (|alpha| < 90 deg);
+    # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn.
 
     # --- curriculum (see lbgp/agent/curriculum.py)
     level_thresholds: tuple = (15.0, 12.0, 8.0)  # exploit return (mean over the window) to advance
@@ -68,11 +87,37 @@ class D4PGConfig:
             raise ValueError(f"need 1+ actors and at most that many exploiting ones, got {self.num_actors}/{self.num_exploit}")
         if self.v_min >= self.v_max or self.num_atoms < 2:
             raise ValueError("the value support needs v_min < v_max and at least 2 atoms")
+        if self.randomize:
+            from lbgp.dynamics import Randomization
+
+            Randomization.from_dict(self.randomize, where="training config 'randomize'")
+        if not 0.0 <= self.spawn_front_share <= 1.0:
+            raise ValueError(f"spawn_front_share must be in [0, 1], got {self.spawn_front_share}")
+        if not 0.0 <= self.noise_correlation < 1.0:
+            raise ValueError(f"noise_correlation must be in [0, 1), got {self.noise_correlation}")
+        if not 0.0 <= self.residual_scale <= 2.0:
+            raise ValueError(f"residual_scale must be in [0, 2], got {self.residual_scale}")
+        if not self.max_updates_per_step > 0:
+            raise ValueError(f"max_updates_per_step must be > 0, got {self.max_updates_per_step}")
         if not self.prior_weight >= 0:
             raise ValueError(f"prior_weight must be >= 0, got {self.prior_weight}")
         if self.n_step < 1 or not 0 < self.discount <= 1:
             raise ValueError("n_step must be >= 1 and discount in (0, 1]")
         return self
+
+    @classmethod
+    def paper(cls, **overrides) -> "D4PGConfig":
+        """The paper's plain configuration (`lbgp train --paper`): tanh actor on the raw observation,
+        no goal prior, uniform spawns, white exploration noise of 0.3, batch 128, one update per step."""
+        plain = dict(residual_scale=0.0, normalize_obs=False, spawn_front_share=0.5, noise_correlation=0.0,
+                     sigma=0.3, prior_weight=0.0, batch_size=128, max_updates_per_step=1.0,
+                     actor_warmup_updates=0)
+        return cls(**{**plain, **overrides})
+
+    @property
+    def actor_residual_scale(self) -> float:
+        """The residual bound the actor is built with (E2E acts on velocities: always plain)."""
+        return self.residual_scale if self.method == "lbgp" else 0.0
 
     @property
     def control(self) -> str:

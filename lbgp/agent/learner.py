@@ -13,10 +13,16 @@ from lbgp.agent.distributional import categorical_projection
 from lbgp.agent.networks import Actor, DistributionalCritic
 
 
+def make_actor(cfg: D4PGConfig, obs_size: int, action_size: int) -> Actor:
+    """The actor a config asks for (the learner's and every actor process's)."""
+    base = action_from_goal(DESIRED_GOAL) if cfg.actor_residual_scale > 0 else None
+    return Actor(obs_size, action_size, cfg.hidden, residual_scale=cfg.actor_residual_scale, base=base)
+
+
 class D4PGLearner:
     def __init__(self, cfg: D4PGConfig, obs_size: int, action_size: int):
         self.cfg = cfg
-        self.actor = Actor(obs_size, action_size, cfg.hidden)
+        self.actor = make_actor(cfg, obs_size, action_size)
         self.critic = DistributionalCritic(obs_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden)
         self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
         self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)
@@ -26,6 +32,16 @@ class D4PGLearner:
         # LBGP's goal prior (cfg.prior_weight): the goal 1.5 m straight ahead of the person
         self.prior = torch.as_tensor(action_from_goal(DESIRED_GOAL), dtype=torch.float32)
         self.prior_weight = cfg.prior_weight if cfg.method == "lbgp" else 0.0
+        self.obs_stats_set = not cfg.normalize_obs  # nothing to set when inputs are not standardised
+
+    def set_obs_stats(self, observations) -> None:
+        """Fix the input standardisation of all four networks from a sample of observations
+        (called once, on the first replay contents, before the first update)."""
+        obs = torch.as_tensor(observations, dtype=torch.float32)
+        mean, std = obs.mean(0), obs.std(0)
+        for net in (self.actor, self.target_actor, self.critic, self.target_critic):
+            net.set_obs_stats(mean, std)
+        self.obs_stats_set = True
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         obs, action = batch["obs"], batch["action"]
@@ -42,10 +58,11 @@ class D4PGLearner:
         self.critic_opt.step()
 
         actor_loss, q = self.actor_loss(obs)
-        self.actor_opt.zero_grad(set_to_none=True)
-        actor_loss.backward()
-        torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
-        self.actor_opt.step()
+        if self.updates >= self.cfg.actor_warmup_updates:
+            self.actor_opt.zero_grad(set_to_none=True)
+            actor_loss.backward()
+            torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
+            self.actor_opt.step()
 
         self.updates += 1
         if self.cfg.target_tau > 0:
@@ -75,6 +92,7 @@ class D4PGLearner:
             "actor_opt": self.actor_opt.state_dict(),
             "critic_opt": self.critic_opt.state_dict(),
             "updates": torch.tensor(self.updates),
+            "obs_stats_set": torch.tensor(self.obs_stats_set),
         }
 
     def load_state_dict(self, state: dict) -> None:
@@ -85,3 +103,4 @@ class D4PGLearner:
         self.actor_opt.load_state_dict(state["actor_opt"])
         self.critic_opt.load_state_dict(state["critic_opt"])
         self.updates = int(state["updates"])
+        self.obs_stats_set = bool(state.get("obs_stats_set", True))

@@ -17,7 +17,8 @@ from lbgp.agent.networks import Actor
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
-VERSION = 1
+VERSION = 2  # 2: input standardisation buffers and the residual goal form (version 1 files still load)
+READABLE = (1, 2)
 
 
 class Policy:
@@ -40,7 +41,7 @@ class Policy:
         return self.actor(torch.from_numpy(obs)[None])[0].numpy()
 
 
-def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict | None = None) -> None:
+def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict | None = None, residual_scale: float = 0.0) -> None:
     save_atomic(
         {
             "format": FORMAT,
@@ -51,6 +52,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "obs_frames": obs_lib.FRAMES,
             "action_size": 2,
             "hidden": list(hidden),
+            "residual_scale": float(residual_scale),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },
@@ -61,8 +63,8 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
 def load_policy(path) -> Policy:
     """Load a policy file; a corrupt, foreign or mismatched file raises a ValueError saying why."""
     data = load_checked(path, FORMAT)
-    if data.get("version") != VERSION:
-        raise ValueError(f"{path}: policy file version {data.get('version')} is not supported (expected {VERSION})")
+    if data.get("version") not in READABLE:
+        raise ValueError(f"{path}: policy file version {data.get('version')} is not supported (expected one of {READABLE})")
     if data.get("obs_size") != obs_lib.SIZE or data.get("obs_frames") != obs_lib.FRAMES:
         raise ValueError(
             f"{path}: policy was trained on {data.get('obs_size')}-number observations of {data.get('obs_frames')} "
@@ -72,12 +74,16 @@ def load_policy(path) -> Policy:
         raise ValueError(f"{path}: unknown policy method {data.get('method')!r} (expected an lbgp policy for method lbgp or e2e)")
     expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
-        actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]))
+        actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]),
+                      residual_scale=float(data.get("residual_scale", 0.0)))
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}
+        weights = dict(data["actor"])
+        if data["version"] == 1:  # no standardisation, plain actor: identity buffers
+            weights = {**{k: v for k, v in actor.state_dict().items() if k not in weights}, **weights}
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ValueError(f"{path}: malformed policy file, expected {expected} ({type(exc).__name__}: {exc})") from None
     try:
-        actor.load_state_dict(data["actor"])
+        actor.load_state_dict(weights)
     except (RuntimeError, KeyError, TypeError, AttributeError) as exc:
         reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:120]
         raise ValueError(f"{path}: actor weights do not match the stored sizes, expected {expected} ({reason})") from None

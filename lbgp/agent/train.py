@@ -242,6 +242,8 @@ class Trainer:
                     if can_learn:
                         # asynchronous actors: a few updates between polls; inline actors: catch up
                         # with the collected steps, so that a seeded run is reproducible
+                        if not self.learner.obs_stats_set:
+                            self.learner.set_obs_stats(self.replay.obs[: len(self.replay)])
                         due = int(cfg.max_updates_per_step * self.env_steps) - self.learner.updates
                         for _ in range(max(due, 0) if getattr(actors, "synchronous", False) else 10):
                             self.learner.update(self.replay.sample(cfg.batch_size, self.rng))
@@ -300,7 +302,8 @@ class Trainer:
             "final_exploit_return_mean_last20": float(np.mean(final_level)) if final_level else None,
             "interrupted": interrupted,
         }
-        save_policy(self.dir / "policy.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden, extra=summary)
+        save_policy(self.dir / "policy.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden, extra=summary,
+                    residual_scale=cfg.actor_residual_scale)
         write_json(self.dir / "summary.json", summary)
         return summary
 

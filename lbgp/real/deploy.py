@@ -9,11 +9,12 @@ from lbgp.real.loop import DeployConfig, DeployLoop
 def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
            log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
            end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None,
-           first_pose_timeout: float | None = None, on_wait=None, on_open=None):
+           first_pose_timeout: float | None = None, on_wait=None, on_open=None, dynamics=None):
     """Run the loop until ``steps`` agent steps (or the source ends, Ctrl-C or a signal); returns the
     loop (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``; an exception raised
     while it ran is in ``loop.error``, after the zero command was sent and the log closed)."""
-    pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance)
+    pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance,
+                                     dynamics=dynamics)
     if on_open is not None:
         address = getattr(pose_source, "address", None)
         on_open(f"listening for poses on udp://{address[0]}:{address[1]}" if address else f"reading poses from {source}")

@@ -28,7 +28,7 @@ def _split(url: str):
     return scheme, target, {k: v[-1] for k, v in urllib.parse.parse_qs(query).items()}
 
 
-def open_source(url: str, robot: str = "turtlebot2", seed: int = 0, person_path=None, disturbance=None):
+def open_source(url: str, robot: str = "turtlebot2", seed: int = 0, person_path=None, disturbance=None, dynamics=None):
     """(source, world): ``world`` is the SimWorld for sim sources, else None."""
     from lbgp.real.udp import UdpPoseSource, parse_address
 
@@ -49,7 +49,10 @@ def open_source(url: str, robot: str = "turtlebot2", seed: int = 0, person_path=
     if scheme == "sim":
         from lbgp.real.sim_world import SimPoseSource, SimWorld
 
-        world = SimWorld(target or "straight_ahead", robot=robot, seed=seed, person_path=person_path)
+        from lbgp.real.sim_world import STANDING_PERSON
+
+        setting = STANDING_PERSON if target == STANDING_PERSON.name else (target or "straight_ahead")
+        world = SimWorld(setting, robot=robot, seed=seed, person_path=person_path, dynamics=dynamics)
         return SimPoseSource(world, disturbance, seed=seed), world
     raise ValueError(f"unknown pose source {url!r}; use vicon://HOST (or another mocap system), udp://PORT, mcap://FILE or sim")
 

@@ -46,7 +46,8 @@ class MocapDisturbance:
 class SimWorld:
     """Robot + walking person in MuJoCo, advanced in steps of ``FRAME_PERIOD``."""
 
-    def __init__(self, setting="straight_ahead", robot: str = "turtlebot2", seed: int = 0, person_path=None, spawn=None):
+    def __init__(self, setting="straight_ahead", robot: str = "turtlebot2", seed: int = 0, person_path=None, spawn=None,
+                 dynamics=None):
         spec = get_robot(robot)
         if person_path is not None:
             setting = tasks.path_setting(person_path, spawn=spawn or (DESIRED_DISTANCE, 0.0))
@@ -54,7 +55,8 @@ class SimWorld:
             setting = tasks.get_setting(setting)
         self.spec = spec
         self.physics = tasks.load_physics(spec)
-        self.task = tasks.FollowAheadTask(spec, setting, control_mode="velocity", obs_noise=False, random=np.random.default_rng(seed))
+        self.task = tasks.FollowAheadTask(spec, setting, control_mode="velocity", obs_noise=False, random=np.random.default_rng(seed),
+                                          dynamics=dynamics)
         self.substeps = int(round(FRAME_PERIOD / float(self.physics.model.opt.timestep)))
         self.listeners: list = []
         self.reset()
@@ -96,6 +98,11 @@ class SimWorld:
 
     def distance_alpha(self) -> tuple[float, float]:
         return self.task.distance_alpha(self.physics)
+
+
+# where `lbgp sysid --excite --source sim` records: the person stands 6 m ahead of the robot
+STANDING_PERSON = tasks.Setting("standing_person", lambda: tasks.StraightMotion(0.0), (6.0, 180.0), noise=False,
+                                random_person_heading=False)
 
 
 class SimClock:

@@ -126,6 +126,9 @@ def make_env(
     person_path=None,
     planner_config=None,
     planner_period: float = PLANNER_PERIOD,
+    spawn_front_share: float = 0.5,
+    dynamics=None,
+    randomize=None,
 ) -> FollowAheadEnv:
     """A follow-ahead environment.
 
@@ -140,6 +143,12 @@ def make_env(
         "velocity" (policy gives (v, w) directly, the E2E baseline).
       horizon: agent steps (0.2 s) per episode; 35 by default.
       obs_noise: Gaussian observation noise on/off; default on for levels, off for scenarios.
+      spawn_front_share: training levels only: the share of random spawns in front of the person
+        (|alpha| < 90 deg); 0.5, the default, spawns uniformly all around (the paper, and evaluation).
+      dynamics: the robot base's response (``lbgp.dynamics``): a ``Dynamics``, ``"nominal"`` (the
+        default), ``"hardware_like"`` or a JSON file (e.g. from ``lbgp sysid``).
+      randomize: domain randomisation per episode around ``dynamics``: a preset name
+        (``lbgp.dynamics.RANDOMIZATION``), a JSON file of ranges or a ``Randomization``; off by default.
     """
     setting = tasks.get_setting(level)
     if person_path is not None:
@@ -149,7 +158,8 @@ def make_env(
     physics = tasks.load_physics(spec)
     task = tasks.FollowAheadTask(
         spec, setting, control_mode=control, obs_noise=obs_noise, planner_config=planner_config,
-        random=np.random.default_rng(seed), planner_period=planner_period,
+        random=np.random.default_rng(seed), planner_period=planner_period, spawn_front_share=spawn_front_share,
+        dynamics=dynamics, randomize=randomize,
     )
     return FollowAheadEnv(physics, task, horizon=horizon, planner_period=planner_period)
 

@@ -21,11 +21,13 @@ from lbgp import stack
 from lbgp.control import Command
 from lbgp.conventions import AGENT_PERIOD, DESIRED_DISTANCE, PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar, yaw_from_quaternion
+from lbgp.dynamics import Dynamics, Randomization, load_dynamics, load_randomization
 from lbgp.sim import observation as obs_lib
+from lbgp.sim.drive import DriveTrain, ModelDynamics
 from lbgp.sim import paths as path_lib
 from lbgp.sim.person import CircleMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
 from lbgp.sim.rewards import follow_ahead_reward, out_of_range
-from lbgp.robots import RobotSpec
+from lbgp.robots import DiffDrive, RobotSpec
 from lbgp.sim.robots import actuator_indices
 from lbgp.world import WorldState
 
@@ -70,6 +72,21 @@ class Physics(dm_mujoco.Physics):
             return float(np.max(offsets + model.geom_rbound[ids]))
 
         self.contact_range = reach(self.robot_body, robot_geoms) + reach(person, person_geoms) + 0.05
+        self.model_dynamics = ModelDynamics(model, self.robot_body, self.left, self.right)
+        self.dynamics = Dynamics()
+        self.drivetrain: DriveTrain | None = None  # None: ideal drive, commands reach the servos at once
+        self._timestep = float(model.opt.timestep)
+
+    def set_dynamics(self, dynamics: Dynamics, rng: np.random.Generator | None = None) -> None:
+        """Apply a robot ``Dynamics`` (model parameters, firmware latency / limiter / lag); also
+        resets the drive train's state (call at an episode's start)."""
+        dynamics = dynamics.validate()
+        self.model_dynamics.apply(dynamics, self._raw_data)
+        self.dynamics = dynamics
+        self.drive = DiffDrive(self.spec.wheel_radius, self.spec.effective_track * dynamics.track_scale)
+        self.drivetrain = None if dynamics.is_ideal_drive else DriveTrain(dynamics, rng)
+        if self.drivetrain is not None:
+            self.drivetrain.reset(float(self._raw_data.time))
 
     # -- robot
     def robot_pose(self) -> np.ndarray:
@@ -97,6 +114,14 @@ class Physics(dm_mujoco.Physics):
         self.forward()
 
     def drive_wheels(self, v: float, w: float) -> None:
+        """Send a (v, w) command to the base: straight to the servos with an ideal drive, else
+        through the drive train (latency, acceleration limiter, lag)."""
+        if self.drivetrain is not None:
+            self.drivetrain.command(float(self._raw_data.time), v, w)
+            return
+        self._set_wheels(v, w)
+
+    def _set_wheels(self, v: float, w: float) -> None:
         left, right = self.drive.wheel_speeds(v, w)
         ctrl = self._raw_data.ctrl
         ctrl[self.left] = left
@@ -113,7 +138,12 @@ class Physics(dm_mujoco.Physics):
         """``nstep`` raw MuJoCo steps (dm_control's ``step`` adds per-call work we do not need)."""
         import mujoco
 
-        mujoco.mj_step(self._raw_model, self._raw_data, nstep)
+        if self.drivetrain is None:
+            mujoco.mj_step(self._raw_model, self._raw_data, nstep)
+            return
+        for _ in range(nstep):
+            self._set_wheels(*self.drivetrain.advance(self._timestep))
+            mujoco.mj_step(self._raw_model, self._raw_data, 1)
 
     def robot_person_contact(self) -> bool:
         data = self._raw_data
@@ -220,8 +250,20 @@ class FollowAheadTask(control.Task):
         planner_config=None,
         random: np.random.Generator | int | None = None,
         planner_period: float = PLANNER_PERIOD,
+        spawn_front_share: float = 0.5,
+        dynamics: Dynamics | str | None = None,
+        randomize: Randomization | str | dict | None = None,
     ):
         self.spec = spec
+        # the robot base's response (lbgp.dynamics): fixed, or drawn per episode around it
+        self.dynamics = load_dynamics(dynamics or "nominal", spec.name)
+        if isinstance(randomize, dict):
+            randomize = Randomization.from_dict(randomize)
+        self.randomization = None if randomize in (None, "none") else load_randomization(randomize)
+        self.episode_dynamics = self.dynamics
+        if not 0.0 <= spawn_front_share <= 1.0:
+            raise ValueError(f"spawn_front_share must be in [0, 1], got {spawn_front_share}")
+        self.spawn_front_share = float(spawn_front_share)  # training levels: share of spawns with |alpha| < 90 deg
         self.setting = setting
         self.motion = setting.motion()
         self.limits = stack.planner_limits(spec, planner_period, planner_config)
@@ -229,6 +271,7 @@ class FollowAheadTask(control.Task):
         self.control_mode = control_mode
         noise_on = setting.noise if obs_noise is None else obs_noise
         self.stack = obs_lib.ObservationStack(noise_std=noise_std if noise_on else None)
+        self._noise_std = noise_std if noise_on else None
         self.rng = random if isinstance(random, np.random.Generator) else np.random.default_rng(random)
         self.person_pose = np.zeros(3)
         self.person_cmd = (0.0, 0.0)
@@ -244,12 +287,15 @@ class FollowAheadTask(control.Task):
         self._prev_person_pose = self.person_pose.copy()
         if self.setting.spawn is None:
             distance = float(self.rng.uniform(*SPAWN_DISTANCE))
-            alpha = float(self.rng.uniform(-math.pi, math.pi))
+            alpha = float(self.rng.uniform(-math.pi / 2, math.pi / 2))  # in front of the person ...
+            if self.rng.uniform() >= self.spawn_front_share:
+                alpha = math.remainder(alpha + math.pi, 2 * math.pi)  # ... or behind
             robot = pose_from_polar(self.person_pose, distance, alpha)
             robot[2] = float(self.rng.uniform(-math.pi, math.pi))
         else:
             distance, alpha_deg = self.setting.spawn
             robot = pose_from_polar(self.person_pose, distance, math.radians(alpha_deg))
+        self._apply_dynamics(physics)
         physics.set_person_pose(self.person_pose)
         physics.set_robot_pose(robot)
         physics.drive_wheels(0.0, 0.0)
@@ -259,6 +305,19 @@ class FollowAheadTask(control.Task):
         self.last_command = Command(0.0, 0.0)
         self.stack.reset(physics.robot_pose(), self.person_pose)
         self.person_cmd = self.motion.command(self.person_pose, CONTROL_PERIOD)
+
+    def _apply_dynamics(self, physics: Physics) -> None:
+        """This episode's robot dynamics: the fixed set, or a draw from the randomisation ranges
+        (and with it the observation noise's scale)."""
+        noise_scale = 1.0
+        if self.randomization is not None:
+            accel = (self.limits.acc_lim_x, self.limits.acc_lim_theta)
+            self.episode_dynamics, noise_scale = self.randomization.sample(
+                self.dynamics, self.rng, accel, physics.model_dynamics.nominal_sliding_friction)
+        if self.episode_dynamics is not physics.dynamics or physics.drivetrain is not None:
+            physics.set_dynamics(self.episode_dynamics, self.rng)
+        if self._noise_std is not None:
+            self.stack.noise_std = tuple(noise_scale * s for s in self._noise_std)
 
     def place_robot(self, physics: Physics, distance: float, alpha: float, relative_yaw: float = 0.0) -> None:
         """Teleport the robot to (D, alpha) from the person (alpha in radians); for tests and tools."""

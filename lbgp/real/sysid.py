@@ -1,0 +1,259 @@
+"""System identification: fit a robot's ``Dynamics`` (latency, response time constant, acceleration
+limits, gains) from a deploy log's commands and motion-capture poses.
+
+    lbgp sysid --excite --robot turtlebot2 --log excite.mcap     # record (sim, or your robot via udp://)
+    lbgp sysid excite.mcap --robot turtlebot2 --out dynamics.json [--png fit.png]
+
+The model is the simulator's own drive train (``lbgp.sim.drive.DriveTrain``: command latency, the
+firmware's acceleration limiter, a first-order lag) followed by gains on v and w (what the wheels
+and the floor make of the setpoint: servo gain, skid-steer slip). The measured body velocity comes
+from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative). For each
+latency on a grid (every 10 ms up to 0.3 s) scipy's ``least_squares`` fits the other five
+parameters; the latency with the smallest residual wins.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from lbgp.actions import MAX_V, MAX_W
+from lbgp.dynamics import Dynamics, nominal
+from lbgp.sim.drive import simulate_setpoints
+
+MIN_DURATION = 5.0  # s of overlapping commands and poses a fit needs
+MIN_POSES = 40
+LATENCY_GRID = np.arange(0.0, 0.301, 0.01)  # s
+VELOCITY_GRID = 0.02  # s, the uniform grid the measured velocity is computed on
+MODEL_DT = 0.01  # s, the drive-train simulation step of the fit
+
+
+@dataclasses.dataclass
+class SysidResult:
+    dynamics: Dynamics
+    latency: float
+    time_constant: float
+    max_linear_accel: float
+    max_angular_accel: float
+    gain_v: float  # achieved / commanded forward speed in steady state
+    gain_w: float  # achieved / commanded yaw rate
+    rms_v: float  # m/s, residual of the fit
+    rms_w: float  # rad/s
+    duration: float  # s of data used
+    samples: int
+    series: dict  # t, measured and simulated v and w (for the plot)
+
+    def summary(self) -> dict:
+        return {
+            "latency_s": round(self.latency, 4), "time_constant_s": round(self.time_constant, 4),
+            "max_linear_accel": round(self.max_linear_accel, 3), "max_angular_accel": round(self.max_angular_accel, 3),
+            "gain_v": round(self.gain_v, 3), "gain_w": round(self.gain_w, 3),
+            "rms_v": round(self.rms_v, 4), "rms_w": round(self.rms_w, 4),
+            "duration_s": round(self.duration, 2), "samples": self.samples,
+        }
+
+
+def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(command times, commands (v, w), pose times, robot poses (x, y, yaw)) from ``read_log``'s dict."""
+    from lbgp.real.mcap_log import pose_of
+
+    cmds = log.get("/cmd_vel", [])
+    poses = log.get("/robot/pose", [])
+    t_cmd = np.array([t for t, _ in cmds], float)
+    u = np.array([[m.linear.x, m.angular.z] for _, m in cmds], float).reshape(-1, 2)
+    t_pose = np.array([t for t, _ in poses], float)
+    p = np.array([pose_of(m) for _, m in poses], float).reshape(-1, 3)
+    return t_cmd, u, t_pose, p
+
+
+def measured_velocity(t_pose: np.ndarray, poses: np.ndarray, dt: float = VELOCITY_GRID) -> tuple[np.ndarray, np.ndarray]:
+    """(grid times, (v, w) per time): body velocity from poses, on a uniform grid."""
+    from scipy.signal import savgol_filter
+
+    order = np.argsort(t_pose)
+    t, p = t_pose[order], poses[order]
+    keep = np.concatenate([[True], np.diff(t) > 1e-6])
+    t, p = t[keep], p[keep]
+    grid = np.arange(t[0], t[-1], dt)
+    yaw = np.unwrap(p[:, 2])
+    x, y, yw = (np.interp(grid, t, c) for c in (p[:, 0], p[:, 1], yaw))
+    window = max(5, int(round(0.2 / dt)) | 1)  # ~0.2 s, odd
+    dx, dy, dyaw = (savgol_filter(c, window, 2, deriv=1, delta=dt) for c in (x, y, yw))
+    v = dx * np.cos(yw) + dy * np.sin(yw)
+    return grid, np.stack([v, dyaw], axis=1)
+
+
+def _check_log(t_cmd, u, t_pose, p) -> None:
+    if len(t_cmd) < 10 or len(t_pose) < MIN_POSES:
+        raise ValueError(f"log too short for system identification: {len(t_cmd)} commands and {len(t_pose)} robot poses "
+                         f"(need >= 10 and >= {MIN_POSES}); record one with `lbgp sysid --excite`")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(p))):
+        raise ValueError("log holds non-finite commands or poses")
+    overlap = min(t_cmd[-1], t_pose[-1]) - max(t_cmd[0], t_pose[0])
+    if overlap < MIN_DURATION:
+        raise ValueError(f"log too short for system identification: {overlap:.1f} s of commands and poses together "
+                         f"(need >= {MIN_DURATION:.0f} s)")
+    if np.ptp(u[:, 0]) < 0.05 and np.ptp(u[:, 1]) < 0.1:
+        raise ValueError("the log's commands hardly change: nothing to identify (record an excitation with `lbgp sysid --excite`)")
+
+
+def fit(log: dict, robot: str) -> SysidResult:
+    """Fit the drive-train parameters to a log (``read_log``'s dict)."""
+    from scipy.optimize import least_squares
+
+    t_cmd, u, t_pose, p = log_series(log)
+    _check_log(t_cmd, u, t_pose, p)
+    grid, measured = measured_velocity(t_pose, p)
+    inside = (grid >= t_cmd[0] + 0.3) & (grid <= t_cmd[-1])  # the first samples: filter edge
+    grid, measured = grid[inside], measured[inside]
+    scale = np.array([max(np.std(measured[:, 0]), 0.02), max(np.std(measured[:, 1]), 0.05)])
+    base = nominal(robot)
+
+    def model(theta, latency):
+        tau, a_v, a_w, k_v, k_w = theta
+        dyn = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w, latency_jitter=0.0)
+        return simulate_setpoints(dyn, t_cmd, u, grid, MODEL_DT) * np.array([k_v, k_w])
+
+    def residual(theta, latency):
+        return ((model(theta, latency) - measured) / scale).ravel()
+
+    # an acceleration limit above the commands' own rate of change never acts (and has no gradient):
+    # the search starts below those rates, and a fit at the top of its range means "not limiting"
+    rates = np.max(np.abs(np.diff(u, axis=0)) / np.maximum(np.diff(t_cmd), 1e-3)[:, None], axis=0)
+    rates = np.maximum(rates, [0.1, 0.2])
+    lo = np.array([0.0, 0.05, 0.1, 0.3, 0.3])
+    hi = np.array([1.0, 1.05 * rates[0], 1.05 * rates[1], 2.0, 2.0])
+    start = np.array([0.05, 0.5 * rates[0], 0.5 * rates[1], 1.0, 1.0])
+    best = None
+    coarse = [(float(np.sum(residual(start, lat) ** 2)), float(lat)) for lat in LATENCY_GRID[::3]]
+    centre = min(coarse)[1]
+    candidates = LATENCY_GRID[np.abs(LATENCY_GRID - centre) <= 0.061]
+    for latency in candidates:
+        sol = least_squares(residual, start, bounds=(lo, hi), args=(float(latency),), x_scale=np.array([0.05, 1.0, 2.0, 0.2, 0.2]),
+                            max_nfev=60)
+        if best is None or sol.cost < best[0].cost:
+            best = (sol, float(latency))
+    sol, latency = best
+    tau, a_v, a_w, k_v, k_w = (float(x) for x in sol.x)
+    simulated = model(sol.x, latency)
+    a_v = math.inf if a_v >= rates[0] else a_v  # not limiting at the rates this log commanded
+    a_w = math.inf if a_w >= rates[1] else a_w
+    err = simulated - measured
+    dynamics = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w,
+                            track_scale=float(np.clip(base.track_scale * k_w / k_v, 0.05, 20.0)))
+    return SysidResult(
+        dynamics, latency, tau, a_v, a_w, k_v, k_w,
+        float(np.sqrt(np.mean(err[:, 0] ** 2))), float(np.sqrt(np.mean(err[:, 1] ** 2))),
+        float(grid[-1] - grid[0]), int(len(grid)),
+        {"t": grid, "measured": measured, "simulated": simulated},
+    )
+
+
+def identify(log_path, robot: str) -> SysidResult:
+    from lbgp.real.mcap_log import read_log
+
+    log = read_log(log_path)
+    try:
+        return fit(log, robot)
+    except ValueError as exc:
+        raise ValueError(f"{log_path}: {exc}") from None
+
+
+def plot_fit(result: SysidResult, path) -> None:
+    """PNG: measured vs simulated v and w over time."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from lbgp.files import atomic_file
+
+    s = result.series
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+    for ax, i, label in ((axes[0], 0, "v (m/s)"), (axes[1], 1, "w (rad/s)")):
+        ax.plot(s["t"], s["measured"][:, i], lw=1, label="measured (mocap)")
+        ax.plot(s["t"], s["simulated"][:, i], lw=1, label="fitted model")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper right")
+    axes[1].set_xlabel("time (s)")
+    r = result.summary()
+    fig.suptitle(f"latency {r['latency_s']} s, tau {r['time_constant_s']} s, accel {r['max_linear_accel']} m/s^2 / "
+                 f"{r['max_angular_accel']} rad/s^2, rms {r['rms_v']} m/s / {r['rms_w']} rad/s", fontsize=9)
+    fig.tight_layout()
+    with atomic_file(path, "wb") as f:
+        fig.savefig(f, format="png", dpi=100)
+    plt.close(fig)
+
+
+# --------------------------------------------------------------------------- excitation
+def excitation_schedule(max_v: float, max_w: float, period: float = 0.2) -> np.ndarray:
+    """(v, w) per agent step: holds, steps and a chirp within 60 % of the limits, mostly turning in
+    place so that the robot stays within ~2 m of where it started. About 40 s."""
+    v, w = 0.6 * max_v, 0.6 * max_w
+    seq: list[tuple[float, float]] = []
+
+    def hold(cmd, seconds):
+        seq.extend([cmd] * int(round(seconds / period)))
+
+    hold((0.0, 0.0), 1.0)
+    for sign in (1, -1):
+        hold((0.0, sign * w), 2.0)
+        hold((0.0, 0.0), 1.5)
+        hold((0.0, sign * 0.5 * w), 1.6)
+        hold((0.0, 0.0), 1.5)
+    for fraction in (1.0, 0.5):
+        hold((fraction * v, 0.0), 1.6)
+        hold((0.0, 0.0), 1.5)
+        hold((0.0, w), 1.0 * math.pi / w)  # turn around ...
+        hold((0.0, 0.0), 1.0)
+    hold((0.5 * v, 0.5 * w), 2.0)
+    hold((0.0, 0.0), 1.5)
+    chirp_t = np.arange(0.0, 8.0, period)
+    freq = 0.1 + (1.2 - 0.1) * chirp_t / 8.0  # Hz, up to below the 2.5 Hz agent-step Nyquist limit
+    phase = 2 * np.pi * np.cumsum(freq) * period
+    seq.extend((0.0, 0.5 * w * math.sin(ph)) for ph in phase)
+    hold((0.0, 0.0), 1.5)
+    return np.array(seq, float)
+
+
+class ExcitationPolicy:
+    """Plays ``excitation_schedule`` as E2E-style velocity actions (the deploy loop's safety checks,
+    acceleration clamp and logging stay on), then zero."""
+
+    control = "velocity"
+
+    def __init__(self, max_v: float, max_w: float):
+        self.schedule = excitation_schedule(max_v, max_w)
+        self.k = 0
+
+    def reset(self) -> None:
+        self.k = 0
+
+    def act(self, observation) -> np.ndarray:
+        v, w = self.schedule[self.k] if self.k < len(self.schedule) else (0.0, 0.0)
+        self.k += 1
+        return np.array([v / MAX_V, w / MAX_W], np.float32)
+
+    @property
+    def steps(self) -> int:
+        return len(self.schedule) + 5
+
+
+def record_excitation(robot: str, log, source: str | None = None, sink: str | None = None, dynamics=None, seed: int = 0,
+                      on_open=None):
+    """Drive the excitation through the deploy loop (safety checks on) and log it to ``log``; the
+    default source is the simulator with a person standing 6 m away (mocap noise, latency and
+    dropped frames on). Returns the finished loop."""
+    from lbgp.planner import planner_config_for
+    from lbgp.real.deploy import deploy
+    from lbgp.real.sim_world import STANDING_PERSON, MocapDisturbance
+
+    limits = planner_config_for(robot)
+    policy = ExcitationPolicy(limits.max_vel_x, limits.max_vel_theta)
+    source = source or f"sim://{STANDING_PERSON.name}"
+    return deploy(policy, source=source, sink=sink, robot=robot, steps=policy.steps, log=log, seed=seed,
+                  disturbance=MocapDisturbance() if source.startswith("sim") else None, dynamics=dynamics,
+                  metadata={"method": "sysid-excitation"}, on_open=on_open)

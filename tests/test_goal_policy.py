@@ -1,0 +1,114 @@
+"""LBGP's redesigned goal policy: residual actor around the goal ahead, input standardisation,
+correlated exploration, front-weighted spawns, actor warm-up, and old policy files still loading."""
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from lbgp.actions import DESIRED_GOAL, action_from_goal, goal_from_action
+from lbgp.agent.actors import ExplorationNoise
+from lbgp.agent.config import D4PGConfig
+from lbgp.agent.learner import D4PGLearner, make_actor
+from lbgp.agent.networks import MIN_OBS_STD, Actor
+from lbgp.agent.policy import load_policy, save_policy
+from lbgp.sim import make_env
+from lbgp.sim import observation as obs_lib
+
+
+def test_untrained_residual_actor_gives_exactly_the_goal_ahead_and_its_range_is_bounded():
+    torch.manual_seed(0)
+    actor = make_actor(D4PGConfig(), obs_lib.SIZE, 2)
+    obs = torch.rand(32, obs_lib.SIZE) * 2 - 1
+    with torch.no_grad():
+        goals = np.array([goal_from_action(a) for a in actor(obs).numpy()])
+    assert np.allclose(goals, DESIRED_GOAL, atol=1e-6)
+    with torch.no_grad():  # saturate the residual: goals stay within +-0.75 m of the goal ahead
+        actor.net[-1].bias.fill_(100.0)
+        far = goal_from_action(actor(obs[:1])[0].numpy())
+    assert np.allclose(far, np.asarray(DESIRED_GOAL) + 0.75, atol=1e-4)
+
+
+def test_paper_preset_is_the_plain_actor_and_e2e_is_never_residual():
+    assert make_actor(D4PGConfig.paper(), obs_lib.SIZE, 2).residual_scale == 0.0
+    assert make_actor(D4PGConfig(method="e2e"), obs_lib.SIZE, 2).residual_scale == 0.0
+    cfg = D4PGConfig.paper()
+    assert (cfg.sigma, cfg.noise_correlation, cfg.spawn_front_share, cfg.prior_weight, cfg.normalize_obs) == (0.3, 0.0, 0.5, 0.0, False)
+
+
+def test_learner_sets_input_standardisation_once_for_all_four_networks():
+    learner = D4PGLearner(D4PGConfig(hidden=(16, 16)), obs_lib.SIZE, 2)
+    assert not learner.obs_stats_set
+    obs = np.random.default_rng(0).normal(0.3, 0.2, (500, obs_lib.SIZE)).astype(np.float32)
+    obs[:, 5] = 0.1  # a constant dimension: its std is floored, not zero
+    learner.set_obs_stats(obs)
+    for net in (learner.actor, learner.target_actor, learner.critic, learner.target_critic):
+        assert torch.allclose(net.norm.obs_mean, torch.from_numpy(obs.mean(0)), atol=1e-5)
+        assert float(net.norm.obs_std[5]) == pytest.approx(MIN_OBS_STD)
+        assert float(net.norm.obs_std[0]) == pytest.approx(0.2, rel=0.15)
+    assert learner.obs_stats_set and bool(learner.state_dict()["obs_stats_set"])
+
+
+def test_actor_stays_fixed_during_warmup_then_learns():
+    torch.manual_seed(0)
+    learner = D4PGLearner(D4PGConfig(hidden=(16, 16), actor_warmup_updates=3, batch_size=8), obs_lib.SIZE, 2)
+    rng = np.random.default_rng(0)
+    batch = {"obs": torch.rand(8, obs_lib.SIZE), "action": torch.rand(8, 2), "ret": torch.rand(8),
+             "discount": torch.full((8,), 0.9), "next_obs": torch.rand(8, obs_lib.SIZE)}
+    first = [p.clone() for p in learner.actor.parameters()]
+    for _ in range(3):
+        learner.update(batch)
+    assert all(torch.equal(a, b) for a, b in zip(first, learner.actor.parameters()))
+    for _ in range(3):
+        learner.update(batch)
+    assert not all(torch.equal(a, b) for a, b in zip(first, learner.actor.parameters()))
+    del rng
+
+
+def test_correlated_exploration_noise_keeps_sigma_and_is_correlated():
+    rng = np.random.default_rng(0)
+    noise = ExplorationNoise(0.2, 0.8, rng)
+    x = np.array([noise.sample() for _ in range(20000)])
+    assert np.std(x) == pytest.approx(0.2, rel=0.05)
+    lag1 = np.corrcoef(x[:-1, 0], x[1:, 0])[0, 1]
+    assert lag1 == pytest.approx(0.8, abs=0.03)
+    white = np.array([ExplorationNoise(0.2, 0.0, rng).sample() for _ in range(2000)])
+    assert abs(np.corrcoef(white[:-1, 0], white[1:, 0])[0, 1]) < 0.1
+
+
+@pytest.mark.parametrize("share, expected", [(0.5, 0.5), (0.9, 0.9), (1.0, 1.0)])
+def test_training_spawns_in_front_with_the_configured_share(share, expected):
+    env = make_env("straight", seed=3, spawn_front_share=share)
+    front = []
+    for _ in range(120):
+        env.reset()
+        alpha = env.info()["alpha"]
+        front.append(abs(alpha) < math.pi / 2)
+    assert np.mean(front) == pytest.approx(expected, abs=0.1)
+
+
+def test_version_1_policy_files_load_as_plain_actors(tmp_path):
+    torch.manual_seed(0)
+    actor = Actor(obs_lib.SIZE, 2, (8,))
+    save_policy(tmp_path / "p.pt", actor, "lbgp", "jackal", (8,))
+    data = torch.load(tmp_path / "p.pt", weights_only=True)
+    data["version"] = 1
+    data.pop("residual_scale")
+    data["actor"] = {k: v for k, v in data["actor"].items() if not k.startswith("norm.") and k != "base"}
+    torch.save(data, tmp_path / "v1.pt")
+    obs = np.random.default_rng(0).uniform(-1, 1, obs_lib.SIZE).astype(np.float32)
+    assert np.allclose(load_policy(tmp_path / "v1.pt").act(obs), load_policy(tmp_path / "p.pt").act(obs))
+
+
+def test_residual_policy_file_round_trips(tmp_path):
+    torch.manual_seed(0)
+    actor = make_actor(D4PGConfig(hidden=(8,)), obs_lib.SIZE, 2)
+    with torch.no_grad():
+        actor.net[-1].bias.fill_(0.3)
+        actor.set_obs_stats(torch.full((obs_lib.SIZE,), 0.1), torch.full((obs_lib.SIZE,), 0.5))
+    save_policy(tmp_path / "r.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
+    obs = np.random.default_rng(1).uniform(-1, 1, obs_lib.SIZE).astype(np.float32)
+    expected = actor(torch.from_numpy(obs)[None])[0].detach().numpy()
+    assert np.allclose(load_policy(tmp_path / "r.pt").act(obs), expected, atol=1e-6)
+    assert not np.allclose(expected, action_from_goal(DESIRED_GOAL))

@@ -212,8 +212,10 @@ def cmd_experiment(args) -> int:
         if args.robot != "turtlebot2":
             raise ValueError("the real-world protocol uses the TurtleBot 2 (the paper's robot): --robot turtlebot2")
         run_real_protocol(args.out, steps=args.steps, seed=args.seed, paths=args.paths, policies=policies, repeats=args.repeats,
-                          command=command)
-        print(Path(args.out, "real_protocol_table.md").read_text())
+                          command=command, dynamics_sets=args.dynamics)
+        for name in ("real_protocol_table.md", "real_protocol_hardware_table.md", "real_protocol_gap.md"):
+            if Path(args.out, name).exists() and (name != "real_protocol_table.md" or "nominal" in args.dynamics):
+                print(Path(args.out, name).read_text())
     else:
         from lbgp.experiments.ablation import run_ablation
 
@@ -361,6 +363,8 @@ def build_parser() -> argparse.ArgumentParser:
                            help="runs per setting (different mocap noise, the same seeds for every method; default 20: "
                                 "a row's winner needs separated 95 %% intervals)")
             q.add_argument("--paths", type=_names, help="comma-separated subset of straight,s_shape,u_turn")
+            q.add_argument("--dynamics", type=_names, default=["nominal", "hardware_like"],
+                           help="comma-separated dynamics sets: nominal (trained on), hardware_like (the held-out robot); default both")
         if name == "ablation":
             q.add_argument("--minutes", type=A.positive_float, default=10.0, help="wall-time budget per training run")
             q.add_argument("--seeds", type=_seed_list, default=[0, 1], help="comma-separated seeds")

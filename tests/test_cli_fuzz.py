@@ -114,7 +114,7 @@ def test_the_case_list_covers_every_option_that_takes_a_value():
     from lbgp.cli import build_parser
 
     # options whose values are free text checked elsewhere (names, URLs) or closed choices
-    free = {"--scenario", "--source", "--sink", "--scenarios", "--paths", "--labels", "--method", "--robot", "--backend"}
+    free = {"--scenario", "--source", "--sink", "--scenarios", "--paths", "--dynamics", "--labels", "--method", "--robot", "--backend"}
 
     def walk(parser, words):
         for action in parser._actions:
@@ -194,6 +194,7 @@ def test_bad_files_found_when_read_are_one_line_errors(sandbox):
         (["evaluate", "--method", "hc", "--episodes", "1", "--scenario", "straight_ahead", "--person-path", str(huge)], "km long"),
         (["replay", str(cut)], "cut.mcap"),
         (["experiment", "real-protocol", "--paths", "zigzag", "--out", str(sandbox / "o")], "unknown protocol path 'zigzag'"),
+        (["experiment", "real-protocol", "--dynamics", "moon", "--out", str(sandbox / "o")], "unknown dynamics set"),
         (["evaluate", "--scenario", "stairs", "--episodes", "1"], "unknown scenario"),
         (["deploy", "--source", "udp://203.0.113.7:47000", "--steps", "1"], "cannot listen on 203.0.113.7"),
     ]

@@ -69,7 +69,11 @@ def test_real_protocol_runs_through_the_deploy_loop_and_ends_far_runs(tmp_path):
     assert far.steps == 8 and far.distances[0] > 3.0
 
     rows = run_real_protocol(tmp_path, steps=4, paths=["s_shape"])
-    assert len(rows) == 12 and {r["setting"] for r in rows} == set(SETTINGS["s_shape"])
+    assert len(rows) == 24 and {r["setting"] for r in rows} == set(SETTINGS["s_shape"])
+    assert {r["dynamics"] for r in rows} == {"nominal", "hardware_like"}  # the held-out robot beside the nominal one
+    assert (tmp_path / "real_protocol_hardware_table.md").is_file()
+    gap = (tmp_path / "real_protocol_gap.md").read_text()
+    assert all(f"| {m} |" in gap for m in ("LBGP", "HC", "E2E"))
     table = read_csv(tmp_path / "real_protocol_table.csv")
     failed = [r for r in table if r["paper_reward"] == "failed"]
     assert {r["setting"] for r in failed} == {s for s in SETTINGS["s_shape"] if paper.REAL[("s_shape", s)]["e2e"] is None}
@@ -144,3 +148,17 @@ def test_scenario_ceiling_is_an_upper_bound():
     bound = scenario_ceiling("turning_inside", 1.5, steps=10)
     got = run_episode(make_env("turning_inside", robot="jackal", seed=0, horizon=10), make_policy("hc")).total_reward
     assert got <= bound + 1e-9 and bound < 10 * 0.75
+
+
+def test_hardware_like_robot_changes_the_protocol_outcome_and_the_gap_sums_per_method():
+    from lbgp.experiments.real_protocol import gap_summary
+
+    policy = make_policy("hc", robot="turtlebot2")
+    nominal = run_setting(policy, "straight", "ahead", steps=15, dynamics="nominal")
+    hardware = run_setting(policy, "straight", "ahead", steps=15, dynamics="hardware_like")
+    assert nominal.total_reward != hardware.total_reward
+    rows = lambda rewards: [{"method": m, "path": "p", "setting": s, "reward": r} for (m, s), r in rewards.items()]  # noqa: E731
+    g = gap_summary(rows({("hc", "a"): 10.0, ("hc", "b"): 6.0, ("e2e", "a"): 12.0, ("e2e", "b"): 2.0}),
+                    rows({("hc", "a"): 8.0, ("hc", "b"): 4.0, ("e2e", "a"): 3.0, ("e2e", "b"): 5.0}))
+    assert g["hc"]["kept"] == pytest.approx(12 / 16) and g["e2e"]["kept"] == pytest.approx(8 / 14)
+    assert g["hc"]["best_settings_hardware"] == 1 and g["e2e"]["best_settings_hardware"] == 1

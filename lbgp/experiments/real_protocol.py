@@ -58,9 +58,12 @@ SETTINGS = {
 }
 
 
-def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None):
+DYNAMICS_SETS = ("nominal", "hardware_like")  # lbgp.dynamics: the trained-on model and the held-out "real" one
+
+
+def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None):
     """One run of the protocol through the deployment loop; returns its EpisodeMetrics."""
-    world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting])
+    world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting], dynamics=dynamics)
     source = SimPoseSource(world, disturbance if disturbance is not None else MocapDisturbance(), seed=seed)
     loop = DeployLoop(source, SimCommandSink(world), policy, DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE),
                       recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=False,
@@ -69,31 +72,77 @@ def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, dist
 
 
 def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods=METHODS, paths=None, policies=None,
-                      repeats: int = 1, command: str = "") -> list[dict]:
+                      repeats: int = 1, command: str = "", dynamics_sets=DYNAMICS_SETS) -> list[dict]:
+    """The protocol on each dynamics set (nominal: real_protocol_table.md; hardware_like:
+    real_protocol_hardware_table.md) and each method's sim-to-real loss (real_protocol_gap.md)."""
     out_dir = Path(out_dir)
     policies = policies or {}
     paths = list(paths or PATHS)
     unknown = [p for p in paths if p not in PATHS]
     if unknown:
         raise ValueError(f"unknown protocol path {', '.join(map(repr, unknown))}; use {', '.join(PATHS)}")
-    rows, pictures = [], {}
-    for method in methods:
-        policy = make_policy(method, policies.get(method), robot="turtlebot2", transfer=True)  # the paper: zero-shot
-        for path in paths:
-            for setting in SETTINGS[path]:
-                collector = TrajectoryCollector()
-                runs = [run_setting(policy, path, setting, steps, seed + r, collector=collector) for r in range(repeats)]
-                rows.append({"path": path, "setting": setting, "method": method, **aggregate(runs)})
-                pictures.setdefault(path, {}).setdefault(setting, {})[method.upper()] = collector.episodes[0]
-    for path, by_setting in pictures.items():
-        for setting, panels in by_setting.items():
-            plot_trajectories(panels, out_dir / "figures" / f"real_protocol_{path}_{setting}.png",
-                              title=f"{path}, {setting} (TurtleBot 2, simulated mocap)")
-    preamble = (f"The paper's real-world protocol in simulation: TurtleBot 2, Jackal-trained policies zero-shot, the "
-                f"`lbgp deploy` loop with simulated mocap (noise, 10-30 ms latency, 2 % dropped frames), {steps} agent steps "
-                f"per setting unless it ends early on contact or D > {END_DISTANCE} m, {repeats} run(s) per setting. "
-                f"Paper numbers are from a real TurtleBot 2; their rows are mapped to settings by the order in the text "
-                f"(see lbgp/experiments/paper.py for the caveat).\n\nMade by: `{command or 'lbgp experiment real-protocol --robot turtlebot2'}`")
-    write_tables(rows, ["path", "setting"], paper.REAL, out_dir / "real_protocol_table.md", out_dir / "real_protocol_table.csv",
-                 "Real-world protocol in simulation (paper Tables: straight, S shape, U-turn)", preamble)
-    return rows
+    bad = [d for d in dynamics_sets if d not in DYNAMICS_SETS]
+    if bad or not dynamics_sets:
+        raise ValueError(f"unknown dynamics set(s) {bad}; use {', '.join(DYNAMICS_SETS)}")
+    all_rows = {}
+    for dynamics in dynamics_sets:
+        rows, pictures = [], {}
+        for method in methods:
+            policy = make_policy(method, policies.get(method), robot="turtlebot2", transfer=True)  # the paper: zero-shot
+            for path in paths:
+                for setting in SETTINGS[path]:
+                    collector = TrajectoryCollector()
+                    runs = [run_setting(policy, path, setting, steps, seed + r, collector=collector, dynamics=dynamics)
+                            for r in range(repeats)]
+                    rows.append({"path": path, "setting": setting, "method": method, "dynamics": dynamics, **aggregate(runs)})
+                    pictures.setdefault(path, {}).setdefault(setting, {})[method.upper()] = collector.episodes[0]
+        all_rows[dynamics] = rows
+        suffix = "" if dynamics == "nominal" else "_hardware"
+        for path, by_setting in pictures.items():
+            for setting, panels in by_setting.items():
+                plot_trajectories(panels, out_dir / "figures" / f"real_protocol{suffix}_{path}_{setting}.png",
+                                  title=f"{path}, {setting} (TurtleBot 2, {dynamics} dynamics, simulated mocap)")
+        robot_words = ("the nominal TurtleBot 2 model (the dynamics the simulator trains on)" if dynamics == "nominal" else
+                       "the held-out hardware-like TurtleBot 2 (lbgp.dynamics.HARDWARE_LIKE: 0.1 s command latency + up to "
+                       "20 ms jitter, 0.12 s motor lag, the Kobuki firmware's 0.5 m/s^2 / 3.5 rad/s^2 limiter, 1.3 x mass "
+                       "and inertia, wheel friction 0.6)")
+        preamble = (f"The paper's real-world protocol in simulation on {robot_words}: Jackal-trained policies zero-shot, the "
+                    f"`lbgp deploy` loop with simulated mocap (noise, 10-30 ms latency, 2 % dropped frames), {steps} agent steps "
+                    f"per setting unless it ends early on contact or D > {END_DISTANCE} m, {repeats} run(s) per setting. "
+                    f"Paper numbers are from a real TurtleBot 2; their rows are mapped to settings by the order in the text "
+                    f"(see lbgp/experiments/paper.py for the caveat).\n\nMade by: "
+                    f"`{command or 'lbgp experiment real-protocol --robot turtlebot2'}`")
+        title = "Real-world protocol in simulation (paper Tables: straight, S shape, U-turn)"
+        write_tables(rows, ["path", "setting"], paper.REAL, out_dir / f"real_protocol{suffix}_table.md",
+                     out_dir / f"real_protocol{suffix}_table.csv", title + ("" if dynamics == "nominal" else ", hardware-like robot"),
+                     preamble)
+    if len(all_rows) == 2:
+        write_gap_table(all_rows["nominal"], all_rows["hardware_like"], out_dir / "real_protocol_gap.md", command)
+    return [r for rows in all_rows.values() for r in rows]
+
+
+def gap_summary(nominal_rows: list[dict], hardware_rows: list[dict]) -> dict:
+    """Per method: reward summed over the settings on each dynamics set, and the share kept."""
+    out = {}
+    for method in dict.fromkeys(r["method"] for r in nominal_rows):
+        nom = sum(r["reward"] for r in nominal_rows if r["method"] == method)
+        hw = sum(r["reward"] for r in hardware_rows if r["method"] == method)
+        wins = sum(1 for a in hardware_rows if a["method"] == method
+                   and all(a["reward"] >= b["reward"] for b in hardware_rows if (b["path"], b["setting"]) == (a["path"], a["setting"])))
+        out[method] = {"nominal": nom, "hardware_like": hw, "kept": hw / nom if nom > 0 else math.nan, "best_settings_hardware": wins}
+    return out
+
+
+def write_gap_table(nominal_rows, hardware_rows, path: Path, command: str = "") -> None:
+    from lbgp.files import write_text
+
+    lines = ["# Sim-to-real loss in the real-world protocol", "",
+             "Reward summed over the protocol's settings, on the nominal TurtleBot 2 and on the held-out hardware-like one "
+             "(see real_protocol_hardware_table.md); kept = hardware-like / nominal (meaningful where the nominal sum is "
+             "positive); best settings = settings where the method has the highest mean reward on the hardware-like robot.",
+             "", f"Made by: `{command or 'lbgp experiment real-protocol --robot turtlebot2'}`", "",
+             "| method | nominal | hardware-like | kept | best settings (hardware-like) |", "|---|---|---|---|---|"]
+    for method, g in gap_summary(nominal_rows, hardware_rows).items():
+        kept = "" if math.isnan(g["kept"]) else f"{g['kept']:.0%}"
+        lines.append(f"| {method.upper()} | {g['nominal']:.1f} | {g['hardware_like']:.1f} | {kept} | {g['best_settings_hardware']} |")
+    write_text(path, "\n".join(lines) + "\n")

@@ -1,0 +1,91 @@
+"""Each method's reward on the nominal robot model vs the held-out hardware-like one (lbgp.dynamics).
+
+    python benchmarks/sim2real_gap.py --json results/sim2real_gap.json [--episodes 10] [--repeats 5]
+        [--e2e-randomized runs/e2e_rand/policy.pt]
+
+Two parts, the same seeds for every method and both dynamics:
+* the paper's 9 simulation scenarios on the Jackal (``lbgp evaluate``'s episodes, observation noise on);
+* the real-world protocol's 12 settings on the TurtleBot 2 through the deploy loop with simulated
+  mocap (``lbgp.experiments.real_protocol.run_setting``; Jackal-trained policies zero-shot).
+
+For each method and part: reward summed over scenarios / settings on each dynamics set, and the
+share kept on the hardware-like robot. Target (sim2real issue): LBGP keeps >= 85 %. An E2E policy
+trained with domain randomisation (``lbgp train --method e2e --randomize default``) is reported
+beside the shipped one when ``--e2e-randomized`` names it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import write_result  # noqa: E402
+
+from lbgp.evaluate import evaluate  # noqa: E402
+from lbgp.experiments.real_protocol import DYNAMICS_SETS, PATHS, SETTINGS, run_setting  # noqa: E402
+from lbgp.policies import make_policy  # noqa: E402
+from lbgp.sim import scenario_names  # noqa: E402
+
+
+def scenario_part(policy, method: str, episodes: int, seed: int) -> dict:
+    out = {}
+    for dynamics in DYNAMICS_SETS:
+        rows = evaluate(policy, method, scenario_names(), robot="jackal", episodes=episodes, seed=seed, obs_noise=True, dynamics=dynamics)
+        out[dynamics] = {r["scenario"]: round(r["reward"], 3) for r in rows}
+    return out
+
+
+def protocol_part(policy, repeats: int, steps: int, seed: int) -> dict:
+    out = {}
+    for dynamics in DYNAMICS_SETS:
+        rewards = {}
+        for path in PATHS:
+            for setting in SETTINGS[path]:
+                runs = [run_setting(policy, path, setting, steps, seed + r, dynamics=dynamics) for r in range(repeats)]
+                rewards[f"{path}/{setting}"] = round(float(np.mean([m.total_reward for m in runs])), 3)
+        out[dynamics] = rewards
+    return out
+
+
+def totals(part: dict) -> dict:
+    nominal, hardware = sum(part["nominal"].values()), sum(part["hardware_like"].values())
+    return {"nominal": round(nominal, 2), "hardware_like": round(hardware, 2),
+            "kept": round(hardware / nominal, 3) if nominal > 0 else None}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--json", default="results/sim2real_gap.json")
+    ap.add_argument("--episodes", type=int, default=10, help="episodes per scenario and dynamics set")
+    ap.add_argument("--repeats", type=int, default=5, help="runs per protocol setting and dynamics set")
+    ap.add_argument("--steps", type=int, default=60, help="agent steps per protocol run")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--e2e-randomized", help="an E2E policy trained with --randomize, reported as e2e_randomized")
+    args = ap.parse_args()
+
+    methods = {"lbgp": None, "hc": None, "e2e": None}
+    if args.e2e_randomized:
+        methods["e2e_randomized"] = args.e2e_randomized
+    result = {"command": "python benchmarks/sim2real_gap.py " + " ".join(sys.argv[1:]), "episodes": args.episodes,
+              "repeats": args.repeats, "methods": {}}
+    t0 = time.perf_counter()
+    for name, path in methods.items():
+        method = "e2e" if name.startswith("e2e") else name
+        scen = scenario_part(make_policy(method, path, robot="jackal"), method, args.episodes, args.seed)
+        proto = protocol_part(make_policy(method, path, robot="turtlebot2", transfer=True), args.repeats, args.steps, args.seed)
+        result["methods"][name] = {"scenarios": {**totals(scen), "per_scenario": scen},
+                                   "real_protocol": {**totals(proto), "per_setting": proto}}
+        print(f"{name}: scenarios {totals(scen)}, protocol {totals(proto)}", file=sys.stderr, flush=True)
+    result["wall_time_s"] = round(time.perf_counter() - t0, 1)
+    if not args.e2e_randomized:
+        result["e2e_randomized"] = "not run: no randomised E2E policy given (--e2e-randomized)"
+    write_result(args.json, result)
+
+
+if __name__ == "__main__":
+    main()

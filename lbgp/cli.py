@@ -13,14 +13,15 @@ from lbgp.policies import default_policy_path
 
 
 def _print_table(rows: list[dict]) -> None:
-    header = f"{'episode':<18}{'steps':>6}{'reward':>9}{'D mean':>8}{'D std':>7}{'alpha mean':>11}{'alpha std':>10}  end"
+    header = (f"{'episode':<18}{'steps':>6}{'reward':>9}{'D mean':>8}{'D std':>7}{'alpha mean':>11}{'alpha std':>10}"
+              f"{'|alpha| 2nd half':>17}  end")
     print(header)
     print("-" * len(header))
     for r in rows:
         end = "contact" if r["collision"] else ("terminated" if r["terminated_early"] else "horizon")
         print(
             f"{r['setting']:<18}{r['steps']:>6d}{r['reward']:>9.2f}{r['distance_mean']:>8.2f}{r['distance_std']:>7.2f}"
-            f"{r['alpha_mean_deg']:>11.1f}{r['alpha_std_deg']:>10.1f}  {end}"
+            f"{r['alpha_mean_deg']:>11.1f}{r['alpha_std_deg']:>10.1f}{r['abs_alpha_second_half_deg']:>17.1f}  {end}"
         )
 
 

@@ -81,6 +81,8 @@ class EpisodeMetrics:
             "distance_std": float(d.std()) if d.size else nan,
             "alpha_mean_deg": float(a.mean()) if a.size else nan,
             "alpha_std_deg": float(a.std()) if a.size else nan,
+            # how far from straight in front the robot was once it had time to get there
+            "abs_alpha_second_half_deg": float(np.abs(a[a.size // 2 :]).mean()) if a.size else nan,
             "collision": bool(self.contact),
             "terminated_early": bool(self.terminated_early),
             "loops": self.loops,

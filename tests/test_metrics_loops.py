@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from lbgp.metrics import EpisodeMetrics, LoopDetector, aggregate, goal_ahead_of_person
 
@@ -42,3 +43,12 @@ def test_goal_ahead_of_person():
     assert goal_ahead_of_person([1.0, 2.5], person)
     assert not goal_ahead_of_person([1.0, 0.5], person)
     assert goal_ahead_of_person(None, person)
+
+
+def test_summary_reports_mean_abs_alpha_over_the_second_half():
+    from lbgp.metrics import EpisodeMetrics
+
+    m = EpisodeMetrics()
+    for alpha in (3.0, -3.0, 0.1, -0.3):  # radians: the first half is far off, the second close
+        m.add(1.5, alpha, 0.0)
+    assert m.summary()["abs_alpha_second_half_deg"] == pytest.approx(math.degrees(0.2))

@@ -214,9 +214,10 @@ def cmd_experiment(args) -> int:
             raise ValueError("the real-world protocol uses the TurtleBot 2 (the paper's robot): --robot turtlebot2")
         run_real_protocol(args.out, steps=args.steps, seed=args.seed, paths=args.paths, policies=policies, repeats=args.repeats,
                           command=command, dynamics_sets=args.dynamics)
-        for name in ("real_protocol_table.md", "real_protocol_hardware_table.md", "real_protocol_gap.md"):
-            if Path(args.out, name).exists() and (name != "real_protocol_table.md" or "nominal" in args.dynamics):
-                print(Path(args.out, name).read_text())
+        tables = {"nominal": "real_protocol_table.md", "hardware_like": "real_protocol_hardware_table.md"}
+        written = [tables[d] for d in args.dynamics] + (["real_protocol_gap.md"] if len(set(args.dynamics)) == 2 else [])
+        for name in written:
+            print(Path(args.out, name).read_text())
     else:
         from lbgp.experiments.ablation import run_ablation
 

@@ -7,8 +7,8 @@ The chain from a (v, w) command to the wheels, as simulated (``lbgp.sim.drive``)
             --[first-order lag, time constant]--> MuJoCo velocity servos (gain, torque limit)
             --> wheels on the floor (friction; mass and inertia of the body)
 
-``NOMINAL`` is today's simulator, calibrated as before (no latency, no lag, the firmware limiter at
-the robot's published values where they exist, MJCF gains and friction): the training default.
+``NOMINAL`` is today's simulator, calibrated as before (the ideal drive: no latency, lag or
+firmware limiter; MJCF gains and friction): the training default.
 ``HARDWARE_LIKE`` is a fixed, documented set outside the training presets' nominal values, the
 "real" robot of ``lbgp experiment real-protocol`` and ``benchmarks/sim2real_gap.py`` (docs/simulation.md
 gives the sources and the reasons for each number). ``RANDOMIZATION`` holds the domain
@@ -91,6 +91,8 @@ class Dynamics:
         for key, value in data.items():
             if value is None and key in ("max_linear_accel", "max_angular_accel"):
                 value = INF
+            if value is None and key not in ("torque_limit", "sliding_friction", "torsional_friction"):
+                raise ValueError(f"{where}: {key} must be a number, got null")
             if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
                 raise ValueError(f"{where}: {key} must be a number, got {value!r}")
             values[key] = None if value is None else float(value)
@@ -215,14 +217,20 @@ class Randomization:
         """(dynamics for one episode, observation-noise scale). ``accel_reference``: the planner's
         (acc_lim_x, acc_lim_theta), which the firmware limiter's sampled values scale."""
         u = lambda r: float(rng.uniform(*r))  # noqa: E731 - one draw per range, in field order
+
+        def limiter(base_limit: float, scale_range, reference: float, scale: float) -> float:
+            # an identity range leaves the firmware limiter as it is (none, in the nominal models)
+            return base_limit if tuple(scale_range) == (1.0, 1.0) else min(base_limit, scale * reference)
+
         lin, ang = u(self.linear_accel_scale), u(self.angular_accel_scale)
+        friction = mjcf_friction if base.sliding_friction is None else base.sliding_friction
         dyn = base.replace(
             latency=u(self.latency), latency_jitter=u(self.latency_jitter), time_constant=u(self.time_constant),
-            max_linear_accel=min(base.max_linear_accel, lin * accel_reference[0]) if self.linear_accel_scale != (1.0, 1.0) else base.max_linear_accel,
-            max_angular_accel=min(base.max_angular_accel, ang * accel_reference[1]) if self.angular_accel_scale != (1.0, 1.0) else base.max_angular_accel,
+            max_linear_accel=limiter(base.max_linear_accel, self.linear_accel_scale, accel_reference[0], lin),
+            max_angular_accel=limiter(base.max_angular_accel, self.angular_accel_scale, accel_reference[1], ang),
             servo_gain_scale=base.servo_gain_scale * u(self.servo_gain_scale),
             mass_scale=base.mass_scale * u(self.mass_scale), inertia_scale=base.inertia_scale * u(self.inertia_scale),
-            sliding_friction=(base.sliding_friction or mjcf_friction) * u(self.friction_scale),
+            sliding_friction=friction * u(self.friction_scale),
             track_scale=base.track_scale * u(self.track_scale),
         )
         return dyn, u(self.obs_noise_scale)

@@ -96,7 +96,7 @@ def test_dynamics_files_and_bad_input(tmp_path):
     d = load_dynamics(good, "turtlebot2")
     assert d.latency == 0.07 and math.isinf(d.max_linear_accel) and d.mass_scale == 1.0
     for text, match in (('{"latency": -1}', "latency"), ('{"warp": 1}', "unknown dynamics"), ('{"latency": "x"}', "number"),
-                        ("[1, 2]", "JSON object"), ("{oops", "not readable JSON")):
+                        ("[1, 2]", "JSON object"), ('{"latency": null}', "latency must be a number"), ("{oops", "not readable JSON")):
         bad = tmp_path / "bad.json"
         bad.write_text(text)
         with pytest.raises(ValueError, match=match):

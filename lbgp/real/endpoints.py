@@ -49,10 +49,7 @@ def open_source(url: str, robot: str = "turtlebot2", seed: int = 0, person_path=
     if scheme == "sim":
         from lbgp.real.sim_world import SimPoseSource, SimWorld
 
-        from lbgp.real.sim_world import STANDING_PERSON
-
-        setting = STANDING_PERSON if target == STANDING_PERSON.name else (target or "straight_ahead")
-        world = SimWorld(setting, robot=robot, seed=seed, person_path=person_path, dynamics=dynamics)
+        world = SimWorld(target or "straight_ahead", robot=robot, seed=seed, person_path=person_path, dynamics=dynamics)
         return SimPoseSource(world, disturbance, seed=seed), world
     raise ValueError(f"unknown pose source {url!r}; use vicon://HOST (or another mocap system), udp://PORT, mcap://FILE or sim")
 

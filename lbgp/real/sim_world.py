@@ -100,11 +100,6 @@ class SimWorld:
         return self.task.distance_alpha(self.physics)
 
 
-# where `lbgp sysid --excite --source sim` records: the person stands 6 m ahead of the robot
-STANDING_PERSON = tasks.Setting("standing_person", lambda: tasks.StraightMotion(0.0), (6.0, 180.0), noise=False,
-                                random_person_heading=False)
-
-
 class SimClock:
     """The loop clock in lock-step with a SimWorld: sleeping advances the simulation."""
 

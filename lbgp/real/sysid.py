@@ -7,9 +7,10 @@ limits, gains) from a deploy log's commands and motion-capture poses.
 The model is the simulator's own drive train (``lbgp.sim.drive.DriveTrain``: command latency, the
 firmware's acceleration limiter, a first-order lag) followed by gains on v and w (what the wheels
 and the floor make of the setpoint: servo gain, skid-steer slip). The measured body velocity comes
-from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative). For each
-latency on a grid (every 10 ms up to 0.3 s) scipy's ``least_squares`` fits the other five
-parameters; the latency with the smallest residual wins.
+from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative). The
+latency is searched on a grid up to 0.3 s: every 30 ms with the other parameters at their start
+values, then every 10 ms within 60 ms of the best; for each of those, scipy's ``least_squares`` fits
+the other five parameters, and the latency with the smallest residual wins.
 """
 
 from __future__ import annotations
@@ -249,11 +250,11 @@ def record_excitation(robot: str, log, source: str | None = None, sink: str | No
     dropped frames on). Returns the finished loop."""
     from lbgp.planner import planner_config_for
     from lbgp.real.deploy import deploy
-    from lbgp.real.sim_world import STANDING_PERSON, MocapDisturbance
+    from lbgp.real.sim_world import MocapDisturbance
 
     limits = planner_config_for(robot)
     policy = ExcitationPolicy(limits.max_vel_x, limits.max_vel_theta)
-    source = source or f"sim://{STANDING_PERSON.name}"
+    source = source or "sim://standing_person"  # lbgp.sim.tasks.TOOL_SETTINGS
     return deploy(policy, source=source, sink=sink, robot=robot, steps=policy.steps, log=log, seed=seed,
                   disturbance=MocapDisturbance() if source.startswith("sim") else None, dynamics=dynamics,
                   metadata={"method": "sysid-excitation"}, on_open=on_open)

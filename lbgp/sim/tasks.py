@@ -85,7 +85,14 @@ class Physics(dm_mujoco.Physics):
         self.dynamics = dynamics
         self.drive = DiffDrive(self.spec.wheel_radius, self.spec.effective_track * dynamics.track_scale)
         self.drivetrain = None if dynamics.is_ideal_drive else DriveTrain(dynamics, rng)
+        self.restart_drive(rng)
+
+    def restart_drive(self, rng: np.random.Generator | None = None) -> None:
+        """Empty the drive train's command queue and state at an episode's start (the model keeps
+        its dynamics); ``rng`` draws the latency jitter from now on."""
         if self.drivetrain is not None:
+            if rng is not None:
+                self.drivetrain.rng = rng
             self.drivetrain.reset(float(self._raw_data.time))
 
     # -- robot
@@ -217,7 +224,13 @@ SCENARIOS: dict[str, Setting] = {
     "trajectory_three": Setting("trajectory_three", _eval_path_motion("three"), (_D, 0.0), **_eval),
 }
 
-ALL_SETTINGS = {**LEVELS, **SCENARIOS}
+# Settings for tools, not for training or the paper's tables: `lbgp sysid --excite` records with the
+# person standing 6 m ahead of the robot (out of its way).
+TOOL_SETTINGS: dict[str, Setting] = {
+    "standing_person": Setting("standing_person", lambda: StraightMotion(0.0), (6.0, 180.0), **_eval),
+}
+
+ALL_SETTINGS = {**LEVELS, **SCENARIOS, **TOOL_SETTINGS}
 
 
 def get_setting(name: str) -> Setting:
@@ -314,8 +327,10 @@ class FollowAheadTask(control.Task):
             accel = (self.limits.acc_lim_x, self.limits.acc_lim_theta)
             self.episode_dynamics, noise_scale = self.randomization.sample(
                 self.dynamics, self.rng, accel, physics.model_dynamics.nominal_sliding_friction)
-        if self.episode_dynamics is not physics.dynamics or physics.drivetrain is not None:
+        if self.episode_dynamics is not physics.dynamics:
             physics.set_dynamics(self.episode_dynamics, self.rng)
+        else:
+            physics.restart_drive(self.rng)
         if self._noise_std is not None:
             self.stack.noise_std = tuple(noise_scale * s for s in self._noise_std)
 

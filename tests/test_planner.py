@@ -59,6 +59,18 @@ def test_reaches_free_space_goals_within_limits(robot, start_yaw, goal_dist, goa
     assert_within_limits(cmds, cfg)
 
 
+@pytest.mark.parametrize("goal_dist, goal_dir", [(2.0, 2.75), (2.0, -2.75), (0.5, 1.77), (1.25, 2.56)])
+def test_turtlebot_turns_to_face_a_goal_behind_or_beside_it(goal_dist, goal_dir):
+    """Cases hypothesis once found: backing up at 0.15 m/s (or parallel parking) instead of turning
+    to face the goal left the TurtleBot 0.1-0.5 m short after 10 s."""
+    cfg = TURTLEBOT2_PLANNER
+    goal = np.array([goal_dist * math.cos(goal_dir), goal_dist * math.sin(goal_dir), 0.0])
+    poses, cmds, statuses = drive(TebPlanner(cfg), [0.0, 0.0, 0.0], goal, steps=100)
+    assert set(statuses) == {OK}
+    assert np.linalg.norm(poses[-1, :2] - goal[:2]) < 0.1
+    assert_within_limits(cmds, cfg)
+
+
 def test_straight_goal_is_driven_fast_and_without_overshoot():
     cfg = JACKAL_PLANNER
     poses, cmds, _ = drive(TebPlanner(cfg), [0, 0, 0], np.array([3.0, 0.0, 0.0]), steps=40)

@@ -50,6 +50,8 @@ class PlannerConfig:
     trust_region_w: float = 1.5  # rad/s change of each segment's w per iteration
     step_tolerance: float = 1e-3  # converged when no v (m/s) or w (rad/s) moves more than this
     turn_around_candidate: bool = True  # turn to face a goal behind the robot when that is faster than backing up
+    turn_candidate_angle: float = 1.0  # rad: the turn band is tried for a goal more than this off the robot's heading
+    turn_candidate_distance: float = 0.05  # m: ... and farther than this at the end of the horizon
     weight_time_to_go: float = 2.0  # per s: candidate bands are compared with the time they leave to the goal
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
     wait_margin: float = 0.3  # m beyond the safety distance that counts as near

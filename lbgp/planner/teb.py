@@ -210,7 +210,8 @@ class TebPlanner:
             v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             lower = self._forward_only(problem) if name == "turn" else self._u_lo  # turning around: forwards only
-            u, status, done = self._solve_band(problem, np.concatenate([v0, w0]), t_start, iterations, lower)
+            band_problem = self._facing_goal(problem) if name == "turn" else problem
+            u, status, done = self._solve_band(band_problem, np.concatenate([v0, w0]), t_start, iterations, lower)
             iterations += done
             if status != OK:
                 if best is not None:
@@ -232,12 +233,27 @@ class TebPlanner:
 
     # ------------------------------------------------------------------ helpers
     def _goal_behind(self, problem: _Problem) -> bool:
-        """Whether the goal, where it will be at the end of the horizon, lies behind the robot (a
-        moving goal that will have caught up by then is met by slowing down or waiting: only a
-        goal still behind makes turning around worth trying)."""
+        """Whether the goal, where it will be at the end of the horizon, lies behind or beside the
+        robot (more than ``turn_candidate_angle`` off its heading, and farther than
+        ``turn_candidate_distance``). A moving goal that will have caught up by then is met by
+        slowing down or waiting: only a goal still behind (or beside: a diff-drive robot cannot
+        move sideways) makes turning to face it worth trying."""
         x, y, th = problem.pose0
         g = problem.goal_path[-1]
-        return math.cos(th) * (g[0] - x) + math.sin(th) * (g[1] - y) < 0.0
+        dx, dy = g[0] - x, g[1] - y
+        dist = math.hypot(dx, dy)
+        ahead = math.cos(th) * dx + math.sin(th) * dy
+        return dist > self.cfg.turn_candidate_distance and ahead < math.cos(self.cfg.turn_candidate_angle) * dist
+
+    @staticmethod
+    def _facing_goal(problem: _Problem) -> _Problem:
+        """The "turn" band's problem: its poses are asked to face the goal (the bearing from the
+        robot to where the goal will be), not to hold the goal's heading. Turning around to a goal
+        behind the robot means pointing away from that heading on the way; tracking it along the
+        band would pull the band back to a half turn. The band's score still uses the goal's own
+        heading (the turn still to come counts in its time to go)."""
+        d = problem.goal_path - problem.pose0[None, :2]
+        return dataclasses.replace(problem, goal_yaw=np.arctan2(d[:, 1], d[:, 0]))
 
     def _forward_only(self, problem: _Problem) -> np.ndarray:
         """Command lower bounds of a forwards-only band: v >= 0 from the moment the robot can have

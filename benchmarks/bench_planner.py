@@ -59,10 +59,10 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0) -> dict:
         def recording_step(problem, u, *rest):
             step, status = original_step(problem, u, *rest)
             if step is not None and len(recorded) < accuracy and len(times) % 7 == 0:
-                p = planner
-                recorded.append((sp.csc_matrix((p._Px, *p._P_struct), shape=(p.n, p.n)), p._q.copy(),
-                                 sp.csc_matrix((p._A[p._A_at], *p._A_struct), shape=(p.m, p.n)), p._lo.copy(),
-                                 p._hi.copy(), np.asarray(p._solver_x[: 2 * p.M]).copy()))
+                qp = planner._qp
+                recorded.append((qp._P.copy(), planner._q.copy(),
+                                 sp.csc_matrix((planner._Ax.copy(), *qp._A_pattern), shape=(qp.m, qp.n)), planner._lo.copy(),
+                                 planner._hi.copy(), qp.x[: 2 * planner.M].copy()))
             return step, status
 
         planner.plan = timed

@@ -44,12 +44,12 @@ import math
 import time
 
 import numpy as np
-import osqp
 import scipy.sparse as sp
 
 from lbgp.geometry import wrap_angle
 from lbgp.planner.config import PlannerConfig
 from lbgp.planner.kinematics import pursuit_commands, rollout
+from lbgp.planner.qp import PRIMAL_INFEASIBLE, SOLVED, SparseQP
 
 OK = "ok"
 INVALID_INPUT = "invalid_input"
@@ -57,9 +57,6 @@ GOAL_IN_COLLISION = "goal_in_collision"
 INFEASIBLE = "infeasible"
 SOLVER_ERROR = "solver_error"
 DIVERGED = "diverged"
-
-_SOLVED = {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE}
-_INFEASIBLE = {osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE, osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE}
 
 
 @dataclasses.dataclass
@@ -139,14 +136,17 @@ class TebPlanner:
             raise ValueError(f"n_poses must be at least 3, got {N}")
         self.N, self.M = N, N - 1
         self.h = float(self.cfg.band_dt)
-        self._solver = None
-        self.stats = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "inaccurate": 0, "unpolished": 0}
         self._setup_structure()
+
+    @property
+    def stats(self) -> dict:
+        """OSQP solves, ADMM iterations, iteration-cap hits, inaccurate and unpolished solutions."""
+        return self._qp.stats.as_dict()
 
     # ------------------------------------------------------------------ public
     def reset(self) -> None:
         """Drop OSQP's warm start (plans never depended on it beyond the solver's tolerance)."""
-        self._solver = None
+        self._qp.reset()
 
     def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0),
              person_turn_rate: float = 0.0, goal_moves_with_person: bool = False) -> Plan:
@@ -348,13 +348,16 @@ class TebPlanner:
         self._clear_at = (np.concatenate([8 * M + k, 8 * M + k]), np.concatenate([X + k, Y + k]))
         A[self._kin_at] = 1.0  # pattern only
         A[self._clear_at] = 1.0
-        self._A = A
         P_pat, A_pat = sp.csc_matrix(np.triu(P) != 0), sp.csc_matrix(A != 0)
-        self._P_struct = (P_pat.indices.copy(), P_pat.indptr.copy())
-        self._A_struct = (A_pat.indices.copy(), A_pat.indptr.copy())
+        A_rows, A_cols = A_pat.indices.copy(), np.repeat(np.arange(n), np.diff(A_pat.indptr))
         P_at = (P_pat.indices.copy(), np.repeat(np.arange(n), np.diff(P_pat.indptr)))
-        self._A_at = (A_pat.indices.copy(), np.repeat(np.arange(n), np.diff(A_pat.indptr)))
-        self._Px = np.triu(P)[P_at]
+        # where each band-dependent entry sits in A's CSC values: the QP is updated in place
+        position = np.full((m, n), -1)
+        position[A_rows, A_cols] = np.arange(len(A_rows))
+        self._kin_pos, self._clear_pos = position[self._kin_at], position[self._clear_at]
+        self._Ax = A[A_rows, A_cols]  # the constant entries; band-dependent ones are set per QP
+        self._qp = SparseQP(n, m, np.triu(P)[P_at], (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),
+                            cfg.osqp_eps, cfg.osqp_max_iter)
         self._q = np.zeros(n)
         self._q[S:] = cfg.weight_clearance_l1
         self._lo = np.zeros(m)
@@ -376,7 +379,13 @@ class TebPlanner:
         track = (poses[1:, :2] - problem.goal_path).T.ravel()
         v, w = u[:M], u[M:]
         heading = wrap_angle(poses[1:, 2] - problem.goal_yaw)
-        return track, heading, np.concatenate([np.diff(v, prepend=problem.v_ref), np.diff(w, prepend=problem.w_ref), w])
+        const = np.empty(3 * M)  # [v changes | w changes | w], the first change from the current command
+        const[:M], const[M : 2 * M], const[2 * M :] = v, w, w
+        const[1:M] -= v[:-1]
+        const[M + 1 : 2 * M] -= w[:-1]
+        const[0] -= problem.v_ref
+        const[M] -= problem.w_ref
+        return track, heading, const
 
     def _candidate_score(self, problem: _Problem, u: np.ndarray, poses: np.ndarray, clearance: np.ndarray) -> float:
         """How candidate bands are ranked: the objective's position, command and clearance terms
@@ -436,14 +445,14 @@ class TebPlanner:
         phi = poses[:-1, 2] + 0.5 * h * w
         c, s = np.cos(phi), np.sin(phi)
         hv = h * v
-        A = self._A
+        Ax = self._Ax
         # d/d(v_k, w_k) and d/d(theta_k) of x_{k+1} - x_k - h v_k cos(phi_k) (and y), k >= 1 for theta
-        A[self._kin_at] = np.concatenate([
+        Ax[self._kin_pos] = np.concatenate([
             -h * c, 0.5 * h * hv * s, -h * s, -0.5 * h * hv * c, hv[1:] * s[1:], -hv[1:] * c[1:],
         ])
         dist = self._clearance(problem, poses)
         normal = (poses[1:, :2] - problem.person_path[1:]) / np.maximum(dist, 1e-9)[:, None]
-        A[self._clear_at] = normal.T.ravel()
+        Ax[self._clear_pos] = normal.T.ravel()
         q = self._q
         track, heading, const = self._residuals(problem, u, poses)
         q[: 2 * M] = 2.0 * self._w_track * track
@@ -452,43 +461,17 @@ class TebPlanner:
         lo, hi = self._lo, self._hi
         lo[3 * M : 5 * M] = np.maximum(lower - u, -self._trust)
         hi[3 * M : 5 * M] = np.maximum(np.minimum(upper - u, self._trust), lo[3 * M : 5 * M])
-        dv = np.diff(v, prepend=problem.v_ref)
-        dw = np.diff(w, prepend=problem.w_ref)
+        dv, dw = const[:M], const[M : 2 * M]  # changes of v and w between segments (from the current command)
         lo[6 * M : 7 * M], hi[6 * M : 7 * M] = -self._acc_v - dv, self._acc_v - dv
         lo[7 * M : 8 * M], hi[7 * M : 8 * M] = -self._acc_w - dw, self._acc_w - dw
         # the current commands satisfy the limits up to rounding: never ask for less than nothing
         hi[6 * M : 8 * M] = np.maximum(hi[6 * M : 8 * M], lo[6 * M : 8 * M])
         lo[8 * M :] = cfg.safety_distance - dist
-        Ax = A[self._A_at]
         if not (np.all(np.isfinite(Ax)) and np.all(np.isfinite(q)) and np.all(np.isfinite(lo))):
             return None, DIVERGED
-        if self._solver is None:
-            self._solver = osqp.OSQP()
-            self._solver.setup(
-                sp.csc_matrix((self._Px, *self._P_struct), shape=(self.n, self.n)), q,
-                sp.csc_matrix((Ax, *self._A_struct), shape=(self.m, self.n)), lo, hi,
-                verbose=False, polishing=True, warm_starting=True,
-                eps_abs=cfg.osqp_eps, eps_rel=cfg.osqp_eps, max_iter=cfg.osqp_max_iter,
-            )
-        else:
-            self._solver.update(Ax=Ax, q=q, l=lo, u=hi)
-        result = self._solver.solve(raise_error=False)
-        self._solver_x = result.x  # the whole QP solution (pose steps first), for benchmarks
-        info = result.info
-        self.stats["solves"] += 1
-        self.stats["osqp_iterations"] += int(info.iter)
-        status = info.status_val
-        if status == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
-            self.stats["max_iter_hits"] += 1
-        if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
-            self.stats["inaccurate"] += 1
-        if info.status_polish != 1:  # polishing did not confirm the active set: accurate to osqp_eps only
-            self.stats["unpolished"] += 1
-        if status in _INFEASIBLE:
+        status = self._qp.solve(Ax, q, lo, hi)
+        if status == PRIMAL_INFEASIBLE:
             return None, INFEASIBLE
-        if status not in _SOLVED:
+        if status != SOLVED:
             return None, SOLVER_ERROR
-        step = np.asarray(result.x[3 * M : 5 * M], dtype=float)
-        if not np.all(np.isfinite(step)):
-            return None, SOLVER_ERROR
-        return step, OK
+        return self._qp.x[3 * M : 5 * M], OK

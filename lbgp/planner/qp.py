@@ -1,0 +1,95 @@
+"""One QP of fixed sparsity, solved again and again with OSQP: set up once, then only values change.
+
+The planner solves ~5 small QPs (~110 variables) per call, so the per-solve overhead of OSQP's
+Python interface (bound clipping, a copy of every matrix for its derivative cache, a namespace
+built from all solver info fields) costs as much as the solve itself. ``SparseQP`` sets the solver
+up through the public interface and then talks to the compiled solver object directly: one
+``update_data_vec``, one ``update_data_mat`` (values only, the pattern never changes), one
+``solve``. ``tests/test_planner_qp.py`` checks it against the public interface.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import osqp
+import scipy.sparse as sp
+
+SOLVED = "solved"
+PRIMAL_INFEASIBLE = "primal_infeasible"
+FAILED = "failed"
+
+_SOLVED = {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE}
+_INFEASIBLE = {osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE, osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE}
+
+
+@dataclasses.dataclass
+class QPStats:
+    """Counts over every solve: ADMM iterations, iteration-cap hits, inaccurate solutions, and
+    solutions whose active set polishing did not confirm (accurate to eps only)."""
+
+    solves: int = 0
+    osqp_iterations: int = 0
+    max_iter_hits: int = 0
+    inaccurate: int = 0
+    unpolished: int = 0
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+class SparseQP:
+    """minimize 1/2 x'Px + q'x  subject to  l <= Ax <= u, with P (upper triangle) and A of a fixed
+    pattern given once as CSC ``(indices, indptr)``; ``solve`` takes the new values of A (in the
+    pattern's order), q, l and u. OSQP warm-starts from the previous solution (only iterations
+    change: every solve runs to ``eps`` and is then polished)."""
+
+    def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int):
+        self.n, self.m = n, m
+        self._P = sp.csc_matrix((np.asarray(P_values, dtype=float), *P_pattern), shape=(n, n))
+        self._A_pattern = A_pattern
+        self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter)
+        self._solver = None
+        self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite
+        self.stats = QPStats()
+        self.x = np.zeros(n)
+
+    def reset(self) -> None:
+        """Forget the warm start (the next solve sets OSQP up again)."""
+        self._solver = None
+
+    def solve(self, A_values: np.ndarray, q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> str:
+        """Solve with these values; returns ``solved`` (``x`` holds the solution),
+        ``primal_infeasible`` or ``failed``."""
+        lower = np.maximum(lower, -self._infinity)
+        upper = np.minimum(upper, self._infinity)
+        if self._solver is None:
+            wrapper = osqp.OSQP()
+            wrapper.setup(self._P, q, sp.csc_matrix((A_values, *self._A_pattern), shape=(self.m, self.n)), lower, upper,
+                          **self._settings)
+            self._wrapper = wrapper  # keeps the compiled solver's owner alive
+            self._solver = wrapper._solver
+        else:
+            self._solver.update_data_vec(q=q, l=lower, u=upper)
+            self._solver.update_data_mat(P_x=None, P_i=None, A_x=A_values, A_i=None)
+        self._solver.solve()
+        info = self._solver.info
+        status = info.status_val
+        stats = self.stats
+        stats.solves += 1
+        stats.osqp_iterations += int(info.iter)
+        if status == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
+            stats.max_iter_hits += 1
+        if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
+            stats.inaccurate += 1
+        if info.status_polish != 1:
+            stats.unpolished += 1
+        if status in _INFEASIBLE:
+            return PRIMAL_INFEASIBLE
+        if status not in _SOLVED:
+            return FAILED
+        self.x = np.array(self._solver.solution.x, dtype=float)
+        if not np.all(np.isfinite(self.x)):
+            return FAILED
+        return SOLVED

@@ -1,0 +1,59 @@
+"""SparseQP (the planner's direct use of the compiled OSQP solver) against OSQP's public interface."""
+
+import numpy as np
+import osqp
+import scipy.sparse as sp
+
+from lbgp.planner.qp import FAILED, PRIMAL_INFEASIBLE, SOLVED, SparseQP
+
+
+def random_problem(rng, n=12, m=18):
+    """A strictly convex QP with a fixed sparsity pattern (box rows plus random sparse rows)."""
+    L = sp.random(n, n, density=0.3, random_state=rng) + sp.eye(n)
+    P = sp.csc_matrix(sp.triu(L @ L.T))
+    pattern = sp.vstack([sp.eye(n), sp.random(m - n, n, density=0.4, random_state=rng) + sp.eye(m - n, n)]).tocsc()
+    pattern.data[:] = 1.0
+    return P, pattern
+
+
+def values(rng, pattern, n, m):
+    A = pattern.copy()
+    A.data = rng.normal(size=A.nnz)
+    q = rng.normal(size=n)
+    lower = -1.0 - rng.uniform(size=m)
+    upper = 1.0 + rng.uniform(size=m)
+    lower[: n // 2] = -np.inf
+    return A, q, lower, upper
+
+
+def test_sequence_of_solves_matches_the_public_interface():
+    rng = np.random.default_rng(0)
+    n, m = 12, 18
+    P, pattern = random_problem(rng, n, m)
+    qp = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-8, max_iter=20000)
+    for _ in range(6):
+        A, q, lower, upper = values(rng, pattern, n, m)
+        assert qp.solve(A.data, q, lower, upper) == SOLVED
+        reference = osqp.OSQP()
+        reference.setup(P, q, A, lower, upper, verbose=False, eps_abs=1e-10, eps_rel=1e-10, max_iter=100000, polishing=True)
+        x = reference.solve(raise_error=False).x
+        np.testing.assert_allclose(qp.x, x, atol=1e-6)
+    assert qp.stats.solves == 6 and qp.stats.osqp_iterations > 0 and qp.stats.max_iter_hits == 0
+
+
+def test_infeasible_and_capped_problems_say_so():
+    rng = np.random.default_rng(1)
+    n, m = 12, 18
+    P, pattern = random_problem(rng, n, m)
+    qp = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-8, max_iter=20000)
+    A, q, lower, upper = values(rng, pattern, n, m)
+    rows, cols = A.indices, np.repeat(np.arange(n), np.diff(A.indptr))
+    A.data[rows == 0] = 1.0  # row 0: x_0 = 2
+    lower[0] = upper[0] = 2.0
+    A.data[rows == n] = np.where(cols[rows == n] == 0, 1.0, 0.0)  # row n: x_0 <= 1
+    lower[n], upper[n] = -1.0, 1.0
+    assert qp.solve(A.data, q, lower, upper) == PRIMAL_INFEASIBLE
+    capped = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-12, max_iter=1)
+    A, q, lower, upper = values(rng, pattern, n, m)
+    assert capped.solve(A.data, q, lower, upper) == FAILED
+    assert capped.stats.max_iter_hits == 1

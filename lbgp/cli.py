@@ -70,7 +70,8 @@ def cmd_evaluate(args) -> int:
         recorder = EpisodeRecorder(args.record, spawn=args.spawn)
     try:
         results = evaluate(policy, args.method, names, robot=args.robot, episodes=args.episodes, seed=args.seed,
-                           recorder=recorder, person_path=args.person_path, dynamics=args.dynamics)
+                           recorder=recorder, person_path=args.person_path, dynamics=args.dynamics,
+                           calibration=args.calibration)
     finally:
         if recorder is not None:
             recorder.close()
@@ -145,7 +146,7 @@ def cmd_deploy(args) -> int:
                       record=args.record, spawn_viewer=args.spawn, seed=args.seed, person_path=args.person_path,
                       planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
                       metadata={"method": args.method, "policy": args.policy or "default"},
-                      first_pose_timeout=args.first_pose_timeout or None, dynamics=args.dynamics,
+                      first_pose_timeout=args.first_pose_timeout or None, dynamics=args.dynamics, calibration=args.calibration,
                       on_open=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True),
                       on_wait=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True))
     except KeyboardInterrupt:  # before the loop ran (opening the source, the log, the viewer)
@@ -262,7 +263,7 @@ def cmd_sysid(args) -> int:
         print(f"  {key:<18}{value}")
     if args.out:
         save_dynamics(Path(args.out), result.dynamics, extra={"fit": summary, "log": str(args.log_file), "robot": args.robot})
-        print(f"dynamics written to {args.out} (use: --dynamics {args.out})")
+        print(f"dynamics written to {args.out} (simulate this robot: --dynamics {args.out}; calibrate commands for it: --calibration {args.out})")
     if args.png:
         plot_fit(result, Path(args.png))
         print(f"measured vs simulated velocity: {args.png}")
@@ -318,6 +319,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--transfer", action="store_true", help="allow a policy file trained on another robot (zero-shot transfer)")
     p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
                    help="robot dynamics: nominal (default), hardware_like, or a JSON file (e.g. from lbgp sysid)")
+    p.add_argument("--calibration", type=A.calibration_spec, default=None,
+                   help="command calibration: none (default) or lbgp sysid's JSON (commands scaled so the robot answers like the simulated one)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -397,6 +400,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", type=A.output_file, help="write the run's summary here")
     p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
                    help="simulated robot only (--source sim): nominal (default), hardware_like, or a JSON file")
+    p.add_argument("--calibration", type=A.calibration_spec, default=None,
+                   help="command calibration: none (default) or lbgp sysid's JSON for this robot (every command sent is scaled by it)")
     p.set_defaults(func=cmd_deploy)
 
     p = sub.add_parser("sysid", help="identify a robot's dynamics from a deploy log (or --excite: record one)")

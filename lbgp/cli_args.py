@@ -83,6 +83,16 @@ def dynamics_spec(text: str) -> str:
         raise argparse.ArgumentTypeError(f"{exc}; use nominal, hardware_like or a JSON file of dynamics parameters") from None
 
 
+def calibration_spec(text: str) -> str:
+    """``none`` or an existing JSON file (``lbgp sysid``'s output, or scale_v / scale_w)."""
+    if text == "none":
+        return text
+    try:
+        return input_file(text)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{exc}; use none or the JSON that lbgp sysid --out wrote") from None
+
+
 def randomize_spec(text: str) -> str:
     """A domain-randomisation preset name or an existing JSON file of ranges."""
     from lbgp.dynamics import RANDOMIZATION

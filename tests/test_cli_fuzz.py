@@ -1,7 +1,7 @@
 """Every bad input to the ``lbgp`` command line ends with one line on stderr that names the
 problem, exit code 2, no traceback, and nothing written.
 
-``BAD_CASES`` enumerates 264 (subcommand, option, invalid value) cases over every option of every
+``BAD_CASES`` enumerates 270 (subcommand, option, invalid value) cases over every option of every
 subcommand that takes a value: counts (negative, zero, NaN, huge, empty, not a number, fractional), rates and
 durations (negative, NaN, infinite, empty, not a number), seeds (negative, too large, not an
 integer), input files (missing, a directory, empty name), output files (a directory, under a
@@ -60,6 +60,7 @@ OPTIONS = [
     (["plot-curves", "RUN"], "--out", "outfile"), (["plot-curves"], None, "rundir"),
     (["evaluate"], "--dynamics", "infile"), (["deploy"], "--dynamics", "infile"), (["sysid", "--excite"], "--dynamics", "infile"),
     (["train"], "--randomize", "infile"), (["train"], "--updates-per-step", "positive"),
+    (["evaluate"], "--calibration", "infile"), (["deploy"], "--calibration", "infile"),
     (["sysid"], None, "infile"), (["sysid", "--excite"], "--log", "outfile"), (["sysid", "LOG"], "--out", "outfile"),
     (["sysid", "LOG"], "--png", "outfile"), (["sysid", "--excite"], "--seed", "seed"),
 ]
@@ -129,7 +130,7 @@ def test_the_case_list_covers_every_option_that_takes_a_value():
     covered = {(w[0] if w[0] != "experiment" else " ".join(w[:2]), o) for w, o, _ in OPTIONS}
     missing = set(walk(build_parser(), [])) - covered
     assert not missing, f"options without bad cases: {sorted(missing, key=str)}"
-    assert len(BAD_CASES) == 264  # the count quoted in the module docstring
+    assert len(BAD_CASES) == 270  # the count quoted in the module docstring
 
 
 @pytest.mark.parametrize("words,option,value", BAD_CASES, ids=[f"{' '.join(w)} {o} {v!r}" for w, o, v in BAD_CASES])
@@ -190,12 +191,16 @@ def test_bad_files_found_when_read_are_one_line_errors(sandbox):
     huge.write_text("x,y\n0,0\n10000000,0\n")  # 10,000 km
     cut = sandbox / "cut.mcap"
     cut.write_bytes(b"\x89MCAP0\r\n\x01\x02\x03")
+    wild = sandbox / "wild_calibration.json"
+    wild.write_text('{"fit": {"gain_v": 1.0, "gain_w": 0.01}, "robot": "jackal"}')  # would turn 86 times harder
     cases = [
         (["evaluate", "--method", "hc", "--episodes", "1", "--scenario", "straight_ahead", "--person-path", str(huge)], "km long"),
         (["replay", str(cut)], "cut.mcap"),
         (["experiment", "real-protocol", "--paths", "zigzag", "--out", str(sandbox / "o")], "unknown protocol path 'zigzag'"),
         (["experiment", "real-protocol", "--dynamics", "moon", "--out", str(sandbox / "o")], "unknown dynamics set"),
         (["evaluate", "--scenario", "stairs", "--episodes", "1"], "unknown scenario"),
+        (["evaluate", "--method", "hc", "--episodes", "1", "--scenario", "straight_ahead", "--calibration", str(wild)],
+         "calibration scale_w must be within"),
         (["deploy", "--source", "udp://203.0.113.7:47000", "--steps", "1"], "cannot listen on 203.0.113.7"),
     ]
     for argv, needle in cases:

@@ -5,6 +5,7 @@ import math
 
 import pytest
 
+from lbgp.calibration import SIM_REFERENCE_GAINS
 from lbgp.cli import main
 from lbgp.dynamics import Dynamics, load_dynamics
 from lbgp.real.mcap_log import LogError
@@ -36,6 +37,15 @@ def test_nominal_robot_fits_without_acceleration_limits(tmp_path):
     r = identify(path, "turtlebot2")
     assert math.isinf(r.max_linear_accel) or r.max_linear_accel > 0.9  # the loop's own clamp is 1 m/s^2
     assert r.latency <= 0.1
+    # the command calibration's reference: what sysid makes of the simulated robot
+    assert (r.gain_v, r.gain_w) == pytest.approx(SIM_REFERENCE_GAINS["turtlebot2"], rel=0.03)
+
+
+def test_calibration_reference_gains_of_the_simulated_jackal(tmp_path):
+    path = tmp_path / "jackal.mcap"
+    record_excitation("jackal", path, seed=1)
+    r = identify(path, "jackal")
+    assert (r.gain_v, r.gain_w) == pytest.approx(SIM_REFERENCE_GAINS["jackal"], rel=0.03)
 
 
 def test_cli_writes_dynamics_that_load_and_a_plot(excitation_log, tmp_path, capsys):

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lbgp.calibration import load_calibration
 from lbgp.experiments import paper
 from lbgp.experiments.tables import write_tables
 from lbgp.metrics import aggregate
@@ -61,11 +62,15 @@ SETTINGS = {
 DYNAMICS_SETS = ("nominal", "hardware_like")  # lbgp.dynamics: the trained-on model and the held-out "real" one
 
 
-def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None):
-    """One run of the protocol through the deployment loop; returns its EpisodeMetrics."""
+def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None,
+                calibration=None):
+    """One run of the protocol through the deployment loop; returns its EpisodeMetrics.
+    ``calibration``: the command calibration (``lbgp.calibration``) of the deploy loop."""
     world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting], dynamics=dynamics)
     source = SimPoseSource(world, disturbance if disturbance is not None else MocapDisturbance(), seed=seed)
-    loop = DeployLoop(source, SimCommandSink(world), policy, DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE),
+    config = DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE,
+                          calibration=load_calibration(calibration, "turtlebot2"))
+    loop = DeployLoop(source, SimCommandSink(world), policy, config,
                       recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=False,
                       name=f"{path}/{setting}")
     return loop.run()

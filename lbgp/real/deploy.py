@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from lbgp.calibration import load_calibration
 from lbgp.real.endpoints import open_sink, open_source
 from lbgp.real.loop import DeployConfig, DeployLoop
 
@@ -9,10 +10,13 @@ from lbgp.real.loop import DeployConfig, DeployLoop
 def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "turtlebot2", steps: int | None = None,
            log=None, record=None, spawn_viewer: bool = False, seed: int = 0, person_path=None, disturbance=None,
            end_distance: float | None = None, metadata: dict | None = None, planner_time_budget: float | None = None,
-           first_pose_timeout: float | None = None, on_wait=None, on_open=None, dynamics=None):
+           first_pose_timeout: float | None = None, on_wait=None, on_open=None, dynamics=None, calibration=None):
     """Run the loop until ``steps`` agent steps (or the source ends, Ctrl-C or a signal); returns the
     loop (metrics in ``loop.metrics``, why it ended in ``loop.end_reason``; an exception raised
-    while it ran is in ``loop.error``, after the zero command was sent and the log closed)."""
+    while it ran is in ``loop.error``, after the zero command was sent and the log closed).
+    ``calibration``: scales every command sent (``lbgp.calibration``: None, a CommandCalibration or
+    ``lbgp sysid``'s JSON)."""
+    calibration = load_calibration(calibration, robot)
     pose_source, world = open_source(source, robot=robot, seed=seed, person_path=person_path, disturbance=disturbance,
                                      dynamics=dynamics)
     if on_open is not None:
@@ -28,7 +32,8 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
         if log:
             from lbgp.real.mcap_log import McapLogger
 
-            logger = McapLogger(log, metadata={"robot": robot, "source": source, **(metadata or {})})
+            calibrated = {} if calibration.is_identity else {"calibration": calibration.to_dict()}
+            logger = McapLogger(log, metadata={"robot": robot, "source": source, **calibrated, **(metadata or {})})
         if record or spawn_viewer:
             from lbgp.viz.recording import EpisodeRecorder
 
@@ -36,7 +41,8 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
         end_condition = (lambda: "contact" if world.contact else None) if world is not None else None
         loop = DeployLoop(pose_source, command_sink, policy, DeployConfig(robot=robot, max_steps=steps, end_distance=end_distance,
                                                                                  planner_time_budget=planner_time_budget,
-                                                                                 first_pose_timeout=first_pose_timeout),
+                                                                                 first_pose_timeout=first_pose_timeout,
+                                                                                 calibration=calibration),
                           logger=logger, recorder=recorder, end_condition=end_condition, on_wait=on_wait)
         loop.error = None
         try:

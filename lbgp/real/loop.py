@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from lbgp import stack
+from lbgp.calibration import CommandCalibration
 from lbgp.conventions import PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha
 from lbgp.metrics import EpisodeMetrics
@@ -77,6 +78,7 @@ class DeployConfig:
     end_distance: float | None = None  # end the run when D exceeds this after having been within it (paper: 3 m)
     first_pose_timeout: float | None = None  # s: end the run ("no_pose") if no valid pose arrived by then
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
+    calibration: CommandCalibration = dataclasses.field(default_factory=CommandCalibration)  # applied to every command sent
 
 
 @dataclasses.dataclass
@@ -181,10 +183,11 @@ class DeployLoop:
             record.band = None if cmd.plan is None else cmd.plan.poses.copy()
         else:
             v, w = self._stop_command()
-        self.command = (v, w)
+        self.command = (v, w)  # the planner's limits chain from its own command, before calibration
+        v, w = self.cfg.calibration.apply(v, w)
         # the robot side sees why it is being stopped: a safety reason, or the planner's safe stop
         self.sink.send(now, v, w, status if record.planner_status in ("", safety_lib.OK) else record.planner_status)
-        record.v, record.w = v, w
+        record.v, record.w = v, w  # what was sent (logged as /cmd_vel: identifying a calibrated run sees the raw base)
         if frames:
             record.latency_s = time.perf_counter() - t_read
         self.ticks += 1

@@ -129,6 +129,7 @@ def make_env(
     spawn_front_share: float = 0.5,
     dynamics=None,
     randomize=None,
+    calibration=None,
 ) -> FollowAheadEnv:
     """A follow-ahead environment.
 
@@ -149,6 +150,8 @@ def make_env(
         default), ``"hardware_like"`` or a JSON file (e.g. from ``lbgp sysid``).
       randomize: domain randomisation per episode around ``dynamics``: a preset name
         (``lbgp.dynamics.RANDOMIZATION``), a JSON file of ranges or a ``Randomization``; off by default.
+      calibration: the command calibration (``lbgp.calibration``) applied where commands reach the
+        wheels: ``None`` (the identity), a ``CommandCalibration`` or a JSON file (``lbgp sysid``'s output).
     """
     setting = tasks.get_setting(level)
     if person_path is not None:
@@ -159,7 +162,7 @@ def make_env(
     task = tasks.FollowAheadTask(
         spec, setting, control_mode=control, obs_noise=obs_noise, planner_config=planner_config,
         random=np.random.default_rng(seed), planner_period=planner_period, spawn_front_share=spawn_front_share,
-        dynamics=dynamics, randomize=randomize,
+        dynamics=dynamics, randomize=randomize, calibration=calibration,
     )
     return FollowAheadEnv(physics, task, horizon=horizon, planner_period=planner_period)
 

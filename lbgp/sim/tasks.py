@@ -18,6 +18,7 @@ from dm_control.rl import control
 from dm_env import specs
 
 from lbgp import stack
+from lbgp.calibration import load_calibration
 from lbgp.control import Command
 from lbgp.conventions import AGENT_PERIOD, DESIRED_DISTANCE, PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar, yaw_from_quaternion
@@ -266,8 +267,11 @@ class FollowAheadTask(control.Task):
         spawn_front_share: float = 0.5,
         dynamics: Dynamics | str | None = None,
         randomize: Randomization | str | dict | None = None,
+        calibration=None,
     ):
         self.spec = spec
+        # what leaves the controller is scaled to what this robot must be told (lbgp.calibration)
+        self.calibration = load_calibration(calibration, spec.name)
         # the robot base's response (lbgp.dynamics): fixed, or drawn per episode around it
         self.dynamics = load_dynamics(dynamics or "nominal", spec.name)
         if isinstance(randomize, dict):
@@ -357,7 +361,7 @@ class FollowAheadTask(control.Task):
     def apply_command(self, physics: Physics) -> Command:
         """One controller tick: (v, w) from the controller, to wheel speeds."""
         self.last_command = self.controller.command(self.world_state(physics))
-        physics.drive_wheels(self.last_command.v, self.last_command.w)
+        physics.drive_wheels(*self.calibration.apply(self.last_command.v, self.last_command.w))
         return self.last_command
 
     def person_pose_at(self, dt) -> np.ndarray:

@@ -370,6 +370,7 @@ class TebPlanner:
         self._trust = np.concatenate([np.full(M, cfg.trust_region_v), np.full(M, cfg.trust_region_w)])
         self._acc_v = np.full(M, cfg.acc_lim_x * h)
         self._acc_v[0] = cfg.acc_lim_x * cfg.control_period
+        self._braking_w = cfg.acc_lim_theta * (cfg.control_period + h * np.arange(M))  # how far |w| can have dropped by segment k
         self._acc_w = np.full(M, cfg.acc_lim_theta * h)
         self._acc_w[0] = cfg.acc_lim_theta * cfg.control_period
 
@@ -431,8 +432,7 @@ class TebPlanner:
         limit lets the robot reach from its current turn rate."""
         cfg, M = self.cfg, self.M
         cap = np.minimum(cfg.max_vel_theta, cfg.lateral_acc_limit / np.maximum(np.abs(u[:M]), 1e-6))
-        reachable = abs(problem.w_ref) - cfg.acc_lim_theta * (cfg.control_period + self.h * np.arange(M))
-        cap = np.maximum(cap, reachable)
+        cap = np.maximum(cap, abs(problem.w_ref) - self._braking_w)
         lo, hi = lower.copy(), self._u_hi.copy()
         lo[M:] = np.maximum(lo[M:], -cap)
         hi[M:] = np.minimum(hi[M:], cap)
@@ -467,7 +467,7 @@ class TebPlanner:
         # the current commands satisfy the limits up to rounding: never ask for less than nothing
         hi[6 * M : 8 * M] = np.maximum(hi[6 * M : 8 * M], lo[6 * M : 8 * M])
         lo[8 * M :] = cfg.safety_distance - dist
-        if not (np.all(np.isfinite(Ax)) and np.all(np.isfinite(q)) and np.all(np.isfinite(lo))):
+        if not math.isfinite(float(Ax.sum()) + float(q.sum()) + float(lo.sum())):  # a NaN or inf anywhere
             return None, DIVERGED
         status = self._qp.solve(Ax, q, lo, hi)
         if status == PRIMAL_INFEASIBLE:

@@ -16,9 +16,10 @@ records what was sent, so that identifying a calibrated run still sees the raw b
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from pathlib import Path
+
+from lbgp.files import read_json
 
 # Gains ``lbgp sysid`` identifies on the nominal simulated robots from ``lbgp sysid --excite`` (sim
 # source, seed 1): achieved / commanded (v, w). tests/test_sysid.py re-identifies them.
@@ -72,12 +73,7 @@ def load_calibration(spec, robot: str) -> CommandCalibration:
     if isinstance(spec, CommandCalibration):
         return spec
     path = Path(spec)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise ValueError(f"calibration file {path} does not exist (use 'none' or the JSON that lbgp sysid --out wrote)") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"calibration file {path}: not readable JSON ({exc})") from None
+    data = read_json(path, "calibration")
     if not isinstance(data, dict):
         raise ValueError(f"calibration file {path}: expected a JSON object")
     if isinstance(data.get("fit"), dict):

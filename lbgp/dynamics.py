@@ -20,11 +20,12 @@ All numbers are SI: seconds, m/s^2, rad/s^2, N*m; scales and multipliers are pla
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from pathlib import Path
 
 import numpy as np
+
+from lbgp.files import read_json, write_json
 
 INF = math.inf
 
@@ -147,12 +148,7 @@ def load_dynamics(path_or_name, robot: str) -> Dynamics:
     if text in ("nominal", "hardware_like"):
         return named(text, robot)
     path = Path(text)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise ValueError(f"dynamics file {path} does not exist") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"dynamics file {path} is not readable JSON ({type(exc).__name__}: {exc})") from None
+    data = read_json(path, "dynamics")
     if isinstance(data, dict) and isinstance(data.get("dynamics"), dict):
         data = data["dynamics"]
     if not isinstance(data, dict):
@@ -161,8 +157,6 @@ def load_dynamics(path_or_name, robot: str) -> Dynamics:
 
 
 def save_dynamics(path, dynamics: Dynamics, extra: dict | None = None) -> None:
-    from lbgp.files import write_json
-
     write_json(path, {"dynamics": dynamics.to_dict(), **(extra or {})})
 
 
@@ -259,8 +253,5 @@ def load_randomization(preset_or_path) -> Randomization:
     path = Path(text)
     if not path.suffix == ".json" and not path.exists():
         raise ValueError(f"unknown randomization preset {text!r}; presets: {sorted(RANDOMIZATION)}, or a JSON file")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"randomization file {path} is not readable JSON ({type(exc).__name__})") from None
+    data = read_json(path, "randomization")
     return Randomization.from_dict(data, where=f"randomization file {path}")

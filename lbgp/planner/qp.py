@@ -49,7 +49,9 @@ class SparseQP:
         self.n, self.m = n, m
         self._P = sp.csc_matrix((np.asarray(P_values, dtype=float), *P_pattern), shape=(n, n))
         self._A_pattern = A_pattern
-        self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter)
+        self._rho = 0.1  # OSQP's default initial step size, set explicitly so that restart() can return to it
+        self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter,
+                              rho=self._rho)
         self._solver = None
         self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite
         self.stats = QPStats()
@@ -58,6 +60,14 @@ class SparseQP:
     def reset(self) -> None:
         """Forget the warm start (the next solve sets OSQP up again)."""
         self._solver = None
+
+    def restart(self) -> None:
+        """Start the next solve as a fresh solver would: from x = y = 0 with the initial rho (OSQP
+        adapts rho from solve to solve, and scales each problem from its own data). A sequence of
+        solves after ``restart`` depends on those QPs alone, not on what was solved before."""
+        if self._solver is not None:
+            self._solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.m))
+            self._solver.update_rho(self._rho)
 
     def solve(self, A_values: np.ndarray, q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> str:
         """Solve with these values; returns ``solved`` (``x`` holds the solution),

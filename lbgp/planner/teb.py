@@ -23,9 +23,10 @@ stop when no command moves more than ``step_tolerance``. The QP's sparsity is fi
 up once, every later solve only updates values.
 
 No hidden state: every call starts from the same deterministic first guess (a pursuit of the
-moving goal within the limits, ``pursuit_commands``), so the command is a function of (robot pose
-and velocity, person pose and velocity, goal) alone; OSQP's warm start (the previous QP's solution)
-only saves ADMM iterations: every QP is solved to ``osqp_eps`` and polished.
+moving goal within the limits, ``pursuit_commands``), and OSQP starts each call as a fresh solver
+would (x = y = 0, the initial rho; its warm start only carries from one QP to the next within a
+call), so the command is a function of (robot pose and velocity, person pose and velocity, goal)
+alone, exactly: where two candidate bands score alike, solver noise cannot tip the choice.
 Local minima (TEB's remedy: bands in distinct topologies): for a goal that will still be behind
 the robot at the end of the horizon, a forwards-only band that turns the robot around is solved
 beside the one that may back up; when the band passes near the person's predicted path, one that
@@ -199,6 +200,7 @@ class TebPlanner:
             goal_yaw=goal_yaw,
             person_path=person_path,
         )
+        self._qp.restart()  # no state from earlier calls: the same input gives the same QPs, solved the same way
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_behind(problem):
             candidates.append("turn")

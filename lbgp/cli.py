@@ -112,7 +112,10 @@ def cmd_train(args) -> int:
 
 def _stop_on_signals():
     """SIGTERM and SIGHUP end ``lbgp deploy`` as Ctrl-C does (zero command, summary, closed log);
-    returns the previous handlers. A second signal while stopping is ignored."""
+    returns the previous handlers. A second signal while stopping is ignored. SIGINT gets Python's
+    own handler (KeyboardInterrupt) even when the process inherited it ignored, as a command started
+    in the background by a non-interactive shell (``nohup lbgp deploy ... &``) does: otherwise
+    ``kill -INT`` would not stop the robot."""
     import signal
 
     from lbgp.real.loop import StopRequested
@@ -124,7 +127,7 @@ def _stop_on_signals():
             stopping.append(number)
             raise StopRequested(signal.Signals(number).name)
 
-    previous = {}
+    previous = {signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler)}
     for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
         if sig is not None:
             previous[sig] = signal.signal(sig, handler)

@@ -54,9 +54,16 @@ class PoseStreamer(threading.Thread):
         sock.close()
 
 
-@pytest.mark.parametrize("sig,code,reason", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "signal SIGTERM"),
-                                             (signal.SIGHUP, 129, "signal SIGHUP")])
-def test_a_signal_stops_the_robot_and_writes_the_summary_and_a_closed_log(tmp_path, sig, code, reason):
+def _ignore_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # what `nohup lbgp deploy ... &` in a script hands down
+
+
+@pytest.mark.parametrize("sig,code,reason,inherited_ignore", [
+    (signal.SIGINT, 130, "interrupted", False), (signal.SIGTERM, 143, "signal SIGTERM", False),
+    (signal.SIGHUP, 129, "signal SIGHUP", False), (signal.SIGINT, 130, "interrupted", True)])
+def test_a_signal_stops_the_robot_and_writes_the_summary_and_a_closed_log(tmp_path, sig, code, reason, inherited_ignore):
+    """Also when the deploy process inherited SIGINT ignored (a background job of a non-interactive
+    shell): it hung until killed before deploy installed its own SIGINT handler."""
     pose_port = free_port()
     robot = UdpCommandListener(("127.0.0.1", 0), allowed_senders=("127.0.0.1",))
     summary, log = tmp_path / "summary.json", tmp_path / "run.mcap"
@@ -64,7 +71,7 @@ def test_a_signal_stops_the_robot_and_writes_the_summary_and_a_closed_log(tmp_pa
     proc = subprocess.Popen(
         [sys.executable, "-m", "lbgp.cli", "deploy", "--method", "scripted", "--source", f"udp://127.0.0.1:{pose_port}",
          "--sink", f"udp://127.0.0.1:{robot.address[1]}", "--json", str(summary), "--log", str(log)],
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, preexec_fn=_ignore_sigint if inherited_ignore else None)
     received = []
     try:
         streamer.start()

@@ -54,12 +54,12 @@ def identified_calibration(robot: str) -> tuple[CommandCalibration, dict]:
                          "scale_v": round(calibration.scale_v, 4), "scale_w": round(calibration.scale_w, 4)}
 
 
-def runs_of(calibrations: dict):
+def runs_of(calibration: CommandCalibration):
     """(column, dynamics, calibration) for the three columns."""
-    return [("nominal", "nominal", None), ("hardware_like", "hardware_like", None), (CALIBRATED, "hardware_like", calibrations)]
+    return [("nominal", "nominal", None), ("hardware_like", "hardware_like", None), (CALIBRATED, "hardware_like", calibration)]
 
 
-def scenario_part(policy, method: str, episodes: int, seed: int, calibration) -> dict:
+def scenario_part(policy, method: str, episodes: int, seed: int, calibration: CommandCalibration) -> dict:
     out = {}
     for column, dynamics, cal in runs_of(calibration):
         rows = evaluate(policy, method, scenario_names(), robot="jackal", episodes=episodes, seed=seed, obs_noise=True,
@@ -68,7 +68,7 @@ def scenario_part(policy, method: str, episodes: int, seed: int, calibration) ->
     return out
 
 
-def protocol_part(policy, repeats: int, steps: int, seed: int, calibration) -> dict:
+def protocol_part(policy, repeats: int, steps: int, seed: int, calibration: CommandCalibration) -> dict:
     out = {}
     for column, dynamics, cal in runs_of(calibration):
         rewards = {}

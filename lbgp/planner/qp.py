@@ -42,8 +42,8 @@ class QPStats:
 class SparseQP:
     """minimize 1/2 x'Px + q'x  subject to  l <= Ax <= u, with P (upper triangle) and A of a fixed
     pattern given once as CSC ``(indices, indptr)``; ``solve`` takes the new values of A (in the
-    pattern's order), q, l and u. OSQP warm-starts from the previous solution (only iterations
-    change: every solve runs to ``eps`` and is then polished)."""
+    pattern's order), q, l and u. OSQP warm-starts from the previous solution until ``restart``
+    (only iterations change: every solve runs to ``eps`` and is then polished)."""
 
     def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int):
         self.n, self.m = n, m
@@ -64,7 +64,9 @@ class SparseQP:
     def restart(self) -> None:
         """Start the next solve as a fresh solver would: from x = y = 0 with the initial rho (OSQP
         adapts rho from solve to solve, and scales each problem from its own data). A sequence of
-        solves after ``restart`` depends on those QPs alone, not on what was solved before."""
+        solves after ``restart`` then agrees with a fresh solver's to about its precision (the
+        planner's property test: 998 of 1,000 random calls within 1e-6, all within 0.05 m/s and
+        0.1 rad/s), whatever was solved before."""
         if self._solver is not None:
             self._solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.m))
             self._solver.update_rho(self._rho)

@@ -202,7 +202,7 @@ class TebPlanner:
         )
         self._qp.restart()  # no state from earlier calls: the same input gives the same QPs, solved the same way
         candidates = ["keep"]
-        if cfg.turn_around_candidate and self._goal_behind(problem):
+        if cfg.turn_around_candidate and self._goal_off_heading(problem):
             candidates.append("turn")
         best, iterations = None, 0
         while candidates:
@@ -234,7 +234,7 @@ class TebPlanner:
         return self._result(v, w, OK, poses, problem, iterations, t_start, name)
 
     # ------------------------------------------------------------------ helpers
-    def _goal_behind(self, problem: _Problem) -> bool:
+    def _goal_off_heading(self, problem: _Problem) -> bool:
         """Whether the goal, where it will be at the end of the horizon, lies behind or beside the
         robot (more than ``turn_candidate_angle`` off its heading, and farther than
         ``turn_candidate_distance``). A moving goal that will have caught up by then is met by

@@ -246,7 +246,7 @@ def _seed_list(text: str) -> list[int]:
 def cmd_plot_curves(args) -> int:
     from lbgp.viz.curves import plot_learning_curves
 
-    plot_learning_curves(args.run_dirs, args.out, labels=args.labels)
+    plot_learning_curves(args.run_dirs, args.out, labels=args.labels, x=args.x, band=args.band)
     print(f"wrote {args.out}")
     return 0
 
@@ -374,11 +374,11 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--dynamics", type=_names, default=["nominal", "hardware_like"],
                            help="comma-separated dynamics sets: nominal (trained on), hardware_like (the held-out robot); default both")
         if name == "ablation":
-            q.add_argument("--minutes", type=A.positive_float, default=10.0, help="wall-time budget per training run")
-            q.add_argument("--seeds", type=_seed_list, default=[0, 1], help="comma-separated seeds")
+            q.add_argument("--minutes", type=A.positive_float, default=30.0, help="wall-time budget per training run (default 30)")
+            q.add_argument("--seeds", type=_seed_list, default=[0, 1, 2], help="comma-separated seeds (default 0,1,2)")
             q.add_argument("--max-steps", type=A.positive_int, help="also stop each run after this many env steps")
             q.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"])
-            q.add_argument("--runs-dir", type=A.output_dir, help="where the training runs go (default: OUT/ablation_runs)")
+            q.add_argument("--runs-dir", type=A.output_dir, help="where the training runs go (default: runs/ablation); runs found there resume")
         q.set_defaults(func=cmd_experiment)
 
     p = sub.add_parser("deploy", help="run a policy on a robot (or the simulated one): poses in, commands out")
@@ -426,10 +426,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", type=A.output_file, help="write the metrics here")
     p.set_defaults(func=cmd_replay)
 
-    p = sub.add_parser("plot-curves", help="learning curves of runs (mean and half-std band over seeds)")
+    p = sub.add_parser("plot-curves", help="learning curves of runs (mean and a half-std or 95 %% CI band over seeds)")
     p.add_argument("run_dirs", nargs="+", type=A.existing_dir, help="run directories; runs with the same label are averaged")
     p.add_argument("--out", type=A.output_file, required=True, help="output image (.png)")
     p.add_argument("--labels", nargs="*", help="one label per run dir (default: method + curriculum from config)")
+    p.add_argument("--x", default="env_steps", choices=["env_steps", "wall_time"], help="horizontal axis (default env_steps)")
+    p.add_argument("--band", default="half_std", choices=["half_std", "ci95"],
+                   help="shaded band: half a standard deviation (the paper's) or the 95 %% CI of the mean")
     p.set_defaults(func=cmd_plot_curves)
     return parser
 

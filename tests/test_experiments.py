@@ -81,8 +81,10 @@ def test_real_protocol_runs_through_the_deploy_loop_and_ends_far_runs(tmp_path):
 
 
 def test_ablation_on_a_tiny_budget(tmp_path):
-    report = run_ablation(tmp_path, minutes=1.0, seeds=[0], steps=150, backend="inline")
+    report = run_ablation(tmp_path, minutes=1.0, seeds=[0], steps=150, backend="inline", runs_dir=tmp_path / "runs")
     assert set(report["runs"]) == {"LBGP_s0", "LBGP-no-curriculum_s0", "E2E_s0"}
+    assert (tmp_path / "runs" / "E2E_s0" / "checkpoint.pt").is_file()
+    assert set(report["final_returns"]) <= {"LBGP", "LBGP-no-curriculum", "E2E"}
     assert report["runs"]["LBGP-no-curriculum_s0"]["final_level"] == "trajectories"
     assert report["runs"]["E2E_s0"]["method"] == "e2e"
     assert (tmp_path / "ablation_curves.png").stat().st_size > 5_000
@@ -162,3 +164,14 @@ def test_hardware_like_robot_changes_the_protocol_outcome_and_the_gap_sums_per_m
                     rows({("hc", "a"): 8.0, ("hc", "b"): 4.0, ("e2e", "a"): 3.0, ("e2e", "b"): 5.0}))
     assert g["hc"]["kept"] == pytest.approx(12 / 16) and g["e2e"]["kept"] == pytest.approx(8 / 14)
     assert g["hc"]["best_settings_hardware"] == 1 and g["e2e"]["best_settings_hardware"] == 1
+
+
+def test_ablation_final_returns_summarise_each_variant_over_its_seeds():
+    from lbgp.experiments.ablation import final_returns
+
+    summaries = {"A_s0": {"final_exploit_return_mean_last20": 1.0}, "A_s1": {"final_exploit_return_mean_last20": 3.0},
+                 "B_s0": {"final_exploit_return_mean_last20": 5.0}, "B_s1": {"final_exploit_return_mean_last20": None}}
+    out = final_returns(summaries, {"A_s0": "A", "A_s1": "A", "B_s0": "B", "B_s1": "B"})
+    assert out["A"]["mean"] == 2.0 and out["A"]["per_seed"] == [1.0, 3.0]
+    assert abs(out["A"]["ci95_half_width"] - 12.706) < 1e-3  # t(0.975, 1) * sqrt(2) / sqrt(2)
+    assert out["B"] == {"per_seed": [5.0], "mean": 5.0, "ci95_half_width": None}

@@ -122,8 +122,33 @@ def test_plot_curves(tmp_path):
         (d / "curve.csv").write_text("\n".join(rows) + "\n")
     plot_learning_curves([tmp_path / "run0", tmp_path / "run1"], tmp_path / "curves.png")
     assert (tmp_path / "curves.png").stat().st_size > 5000
+    plot_learning_curves([tmp_path / "run0", tmp_path / "run1"], tmp_path / "wall.png", x="wall_time", band="ci95")
+    assert (tmp_path / "wall.png").stat().st_size > 5000
+    with pytest.raises(ValueError, match="band must be one of"):
+        plot_learning_curves([tmp_path / "run0"], tmp_path / "x.png", band="std")
     with pytest.raises(ValueError, match="not a training run directory"):
         plot_learning_curves([tmp_path], tmp_path / "x.png")
+
+
+def test_curves_against_wall_time_and_their_confidence_band(tmp_path):
+    from lbgp.viz.curves import curve_band, smoothed_curve
+
+    d = tmp_path / "run"
+    d.mkdir()
+    # 10 env steps per second of wall time, return = 2 * seconds
+    rows = ["env_steps,wall_time_s,level,exploit_return"] + [f"{10 * i},{i},straight,{2.0 * i}" for i in range(1, 30)]
+    (d / "curve.csv").write_text("\n".join(rows) + "\n")
+    by_time = smoothed_curve(d, np.array([15.0, 100.0]), window=1, x="wall_time")
+    by_steps = smoothed_curve(d, np.array([150.0]), window=1)
+    assert by_time[0] == pytest.approx(30.0) and by_steps[0] == pytest.approx(30.0) and np.isnan(by_time[1])
+    # three runs 1, 2, 3 at a point: mean 2, 95 % CI half-width t(0.975, 2) * 1 / sqrt(3) = 2.484;
+    # where one run has ended, the band uses the two left; a single run has no band
+    curves = np.array([[1.0, 1.0, 5.0], [2.0, 3.0, np.nan], [3.0, np.nan, np.nan]])
+    mean, half = curve_band(curves, "ci95")
+    assert mean == pytest.approx([2.0, 2.0, 5.0])
+    assert half == pytest.approx([2.484, 12.706 * np.sqrt(2.0) / np.sqrt(2.0), 0.0], abs=1e-3)
+    mean, half = curve_band(curves, "half_std")
+    assert half[0] == pytest.approx(0.5 * np.std([1.0, 2.0, 3.0]))
 
 
 def test_ray_backend_trains_where_ray_is_installed(tmp_path):

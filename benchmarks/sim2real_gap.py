@@ -1,7 +1,7 @@
 """Each method's reward on the nominal robot model vs the held-out hardware-like one (lbgp.dynamics).
 
     python benchmarks/sim2real_gap.py --json results/sim2real_gap.json [--episodes 10] [--repeats 5]
-        [--e2e-randomized runs/e2e_rand/policy.pt]
+        [--e2e-randomized runs/e2e_rand/policy.pt] [--lbgp-policy FILE] [--methods lbgp,hc,e2e,e2e_randomized]
 
 Two parts, the same seeds for every method and both dynamics:
 * the paper's 9 simulation scenarios on the Jackal (``lbgp evaluate``'s episodes, observation noise on);
@@ -95,11 +95,19 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=60, help="agent steps per protocol run")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--e2e-randomized", help="an E2E policy trained with --randomize, reported as e2e_randomized")
+    ap.add_argument("--lbgp-policy", help="LBGP policy file (default: the shipped one)")
+    ap.add_argument("--methods", default="lbgp,hc,e2e,e2e_randomized",
+                    help="comma-separated subset of lbgp,hc,e2e,e2e_randomized (default: all; e2e_randomized needs --e2e-randomized)")
     args = ap.parse_args()
 
-    methods = {"lbgp": None, "hc": None, "e2e": None}
+    wanted = [m.strip() for m in args.methods.split(",") if m.strip()]
+    unknown = set(wanted) - {"lbgp", "hc", "e2e", "e2e_randomized"}
+    if unknown:
+        ap.error(f"unknown methods {sorted(unknown)}: use lbgp, hc, e2e, e2e_randomized")
+    methods = {"lbgp": args.lbgp_policy, "hc": None, "e2e": None}
     if args.e2e_randomized:
         methods["e2e_randomized"] = args.e2e_randomized
+    methods = {name: path for name, path in methods.items() if name in wanted}
     result = {"command": "python benchmarks/sim2real_gap.py " + " ".join(sys.argv[1:]), "episodes": args.episodes,
               "repeats": args.repeats, "methods": {}}
     t0 = time.perf_counter()
@@ -117,7 +125,7 @@ def main() -> None:
                                    "real_protocol": {**totals(proto), "per_setting": proto}}
         print(f"{name}: scenarios {totals(scen)}, protocol {totals(proto)}", file=sys.stderr, flush=True)
     result["wall_time_s"] = round(time.perf_counter() - t0, 1)
-    if not args.e2e_randomized:
+    if not args.e2e_randomized and "e2e_randomized" in wanted:
         result["e2e_randomized"] = "not run: no randomised E2E policy given (--e2e-randomized)"
     write_result(args.json, result)
 

@@ -1,0 +1,177 @@
+"""What a goal policy can reach through the real planner and robot: a searched goal sequence per scenario.
+
+    python benchmarks/goal_ceiling.py --json results/goal_ceiling.json
+    python benchmarks/goal_ceiling.py --start-from lbgp --segment 1 --std 0.15 --iterations 10 \
+        --scenarios turning_ahead,... --json results/goal_ceiling_refined.json
+
+``lbgp.experiments.ceiling`` bounds every method from above with a relaxed point robot (no heading,
+no acceleration limit); it says nothing about what the TEB planner and the real base let a *goal*
+policy do. This benchmark searches, per paper scenario (Jackal, seed 0, no observation noise: the
+scenario's person motion is deterministic), for the sequence of goals that earns the most reward
+when the planner drives to it: the goal in the person frame is held for ``segment`` agent steps at
+a time (default 7 segments of 1 s in a 35-step episode), and the cross-entropy method searches
+those numbers (population 24, 6 elites, 8 iterations), started from the constant goal 1.5 m ahead
+or (``--start-from lbgp``) from the goals the shipped LBGP asks for in the same episode, whose
+open-loop replay is that very episode.
+
+An open-loop sequence tuned to one deterministic episode knows the future, which no policy does,
+so its return is an optimistic target for LBGP; the search is not exhaustive either, so it is a
+lower bound on the best open-loop sequence (a closed-loop policy can beat a weak search). Reported
+beside it: the constant goal 1.5 m ahead, HC and the shipped LBGP on the same noise-free episode,
+and the relaxed point robot's ceiling.
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import write_result  # noqa: E402
+
+from lbgp.actions import DESIRED_GOAL, GOAL_X, GOAL_Y, action_from_goal, goal_from_action  # noqa: E402
+from lbgp.policies import make_policy  # noqa: E402
+from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.rollout import run_episode  # noqa: E402
+from lbgp.sim import make_env  # noqa: E402
+from lbgp.sim.tasks import DEFAULT_HORIZON, SCENARIOS  # noqa: E402
+
+TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
+TRAJECTORIES = ("trajectory_one", "trajectory_two", "trajectory_three")
+
+
+class GoalSequencePolicy:
+    """Plays a fixed goal sequence: goal ``goals[k // segment]`` (person frame, m) at agent step k."""
+
+    control = "goal"
+
+    def __init__(self, goals, segment: int):
+        self.actions = [action_from_goal(g).astype(np.float32) for g in np.asarray(goals, float).reshape(-1, 2)]
+        self.segment = segment
+        self.k = 0
+
+    def reset(self) -> None:
+        self.k = 0
+
+    def act(self, observation) -> np.ndarray:
+        action = self.actions[min(self.k // self.segment, len(self.actions) - 1)]
+        self.k += 1
+        return action
+
+
+class RecordingPolicy:
+    """Wraps a closed-loop goal policy and records the goal it asks for at each step."""
+
+    control = "goal"
+
+    def __init__(self, policy):
+        self.policy, self.goals = policy, []
+
+    def reset(self) -> None:
+        self.goals = []
+        if hasattr(self.policy, "reset"):
+            self.policy.reset()
+
+    def act(self, observation) -> np.ndarray:
+        action = self.policy.act(observation)
+        self.goals.append(goal_from_action(action))
+        return action
+
+
+def closed_loop_goals(scenario: str, method: str, robot: str = "jackal") -> tuple[float, np.ndarray]:
+    """A closed-loop method's return on the noise-free scenario episode and the goals it asked for."""
+    policy = RecordingPolicy(make_policy(method, robot=robot, transfer=True))
+    total = run_episode(make_env(scenario, robot=robot, seed=0, obs_noise=False), policy).total_reward
+    return float(total), np.array(policy.goals)
+
+
+def search(scenario: str, robot: str = "jackal", segment: int = 5, population: int = 24, elites: int = 6,
+           iterations: int = 8, std: float = 0.4, seed: int = 0, start=None) -> dict:
+    """Cross-entropy search over one scenario's goal sequence; returns the best sequence and its return.
+
+    ``start``: a per-step goal sequence (35, 2) to start from (e.g. a closed-loop method's goals,
+    whose open-loop replay is the same episode), averaged over each segment; default the constant
+    goal 1.5 m ahead."""
+    env = make_env(scenario, robot=robot, seed=0, obs_noise=False)
+    rng = np.random.default_rng(seed)
+    segments = -(-DEFAULT_HORIZON // segment)
+    lo, hi = np.array([GOAL_X[0], GOAL_Y[0]]), np.array([GOAL_X[1], GOAL_Y[1]])
+
+    def score(goals):
+        return run_episode(env, GoalSequencePolicy(goals, segment)).total_reward
+
+    constant = score(np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1)))
+    if start is None:
+        mean = np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1))
+        best = constant
+    else:
+        start = np.asarray(start, float).reshape(-1, 2)
+        mean = np.array([start[k * segment : (k + 1) * segment].mean(axis=0) for k in range(segments)])
+        best = score(mean)
+    sigma = np.full_like(mean, std)
+    best_goals = mean.copy()
+    history = [best]
+    for _ in range(iterations):
+        samples = np.clip(mean + sigma * rng.standard_normal((population, *mean.shape)), lo, hi)
+        samples[0] = best_goals  # elitism: the best so far is always re-scored (deterministic: same value)
+        returns = np.array([score(s) for s in samples])
+        order = np.argsort(returns)[::-1]
+        if returns[order[0]] > best:
+            best, best_goals = float(returns[order[0]]), samples[order[0]].copy()
+        elite = samples[order[:elites]]
+        mean, sigma = elite.mean(axis=0), np.maximum(elite.std(axis=0), 0.02)
+        history.append(best)
+    return {"constant_1_5": float(constant), "start": history[0], "best": float(best), "goals": best_goals.tolist(),
+            "history": [float(h) for h in history], "rollouts": 1 + (start is not None) + iterations * population}
+
+
+def one(args) -> dict:
+    scenario, robot, start_from, kwargs = args
+    from lbgp.experiments.ceiling import scenario_ceiling
+
+    hc, _ = closed_loop_goals(scenario, "hc", robot)
+    lbgp, lbgp_goals = closed_loop_goals(scenario, "lbgp", robot)
+    row = search(scenario, robot, start=lbgp_goals if start_from == "lbgp" else None, **kwargs)
+    row["start_from"] = start_from
+    row["hc"], row["lbgp"] = hc, lbgp
+    row["point_robot_ceiling"] = scenario_ceiling(scenario, planner_config_for(robot).max_vel_x)
+    print(f"{scenario}: searched {row['best']:.2f}  constant {row['constant_1_5']:.2f}  HC {row['hc']:.2f}  "
+          f"LBGP {row['lbgp']:.2f}  point robot {row['point_robot_ceiling']:.2f}", flush=True)
+    return row
+
+
+def main(argv=None) -> dict:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--json", default="results/goal_ceiling.json")
+    p.add_argument("--robot", default="jackal", choices=("jackal", "turtlebot2"))
+    p.add_argument("--scenarios", default=",".join(SCENARIOS))
+    p.add_argument("--iterations", type=int, default=8)
+    p.add_argument("--population", type=int, default=24)
+    p.add_argument("--segment", type=int, default=5, help="agent steps each goal is held")
+    p.add_argument("--std", type=float, default=0.4, help="initial search spread of each goal coordinate (m)")
+    p.add_argument("--start-from", choices=("constant", "lbgp"), default="constant",
+                   help="start the search at the constant goal 1.5 m ahead or at the shipped LBGP's goals")
+    p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
+    args = p.parse_args(argv)
+    scenarios = [s for s in args.scenarios.split(",") if s]
+    kwargs = dict(iterations=args.iterations, population=args.population, segment=args.segment, std=args.std)
+    jobs = [(s, args.robot, args.start_from, kwargs) for s in scenarios]
+    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
+        rows = dict(zip(scenarios, pool.map(one, jobs, chunksize=1)))
+    sums = {}
+    for group, names in (("turning", TURNING), ("trajectories", TRAJECTORIES)):
+        if all(n in rows for n in names):
+            sums[group] = {k: round(sum(rows[n][k] for n in names), 2)
+                           for k in ("best", "constant_1_5", "hc", "lbgp", "point_robot_ceiling")}
+    result = {"benchmark": "goal_ceiling", "robot": args.robot, "settings": {**kwargs, "start_from": args.start_from}, "scenarios": rows, "sums": sums}
+    write_result(args.json, result)
+    return result
+
+
+if __name__ == "__main__":
+    main()

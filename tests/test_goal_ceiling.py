@@ -1,0 +1,43 @@
+"""benchmarks/goal_ceiling.py: the searched goal sequence is a real, replayable episode."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+from goal_ceiling import GoalSequencePolicy, closed_loop_goals, search  # noqa: E402
+
+from lbgp.actions import action_from_goal  # noqa: E402
+from lbgp.rollout import run_episode  # noqa: E402
+from lbgp.sim import make_env  # noqa: E402
+
+
+def test_goal_sequence_holds_each_goal_for_its_segment_and_restarts_on_reset():
+    goals = [[1.0, 0.0], [2.0, 0.5], [1.5, -0.5]]
+    policy = GoalSequencePolicy(goals, segment=2)
+    played = [policy.act(None) for _ in range(7)]
+    expected = [action_from_goal(goals[k]) for k in (0, 0, 1, 1, 2, 2, 2)]  # the last goal is held past the end
+    np.testing.assert_allclose(played, expected, atol=1e-6)
+    policy.reset()
+    np.testing.assert_allclose(policy.act(None), action_from_goal(goals[0]), atol=1e-6)
+
+
+def test_search_never_reports_less_than_the_constant_goal_and_its_best_sequence_replays_to_its_return():
+    row = search("turning_ahead", population=3, elites=1, iterations=1, segment=7)
+    assert row["best"] >= row["constant_1_5"]
+    assert len(row["goals"]) == 5 and row["rollouts"] == 4
+    replay = run_episode(make_env("turning_ahead", robot="jackal", seed=0, obs_noise=False),
+                         GoalSequencePolicy(row["goals"], 7)).total_reward
+    assert abs(replay - row["best"]) < 1e-6  # deterministic: the same goals give the same episode
+
+
+def test_a_search_started_from_lbgps_goals_starts_at_lbgps_closed_loop_return():
+    """The noise-free scenario is deterministic, so the shipped LBGP's goals replayed open-loop
+    (one per step) give its own episode back: the search starts where the policy is."""
+    lbgp, goals = closed_loop_goals("turning_inside", "lbgp")
+    assert goals.shape == (35, 2)
+    row = search("turning_inside", population=2, elites=1, iterations=1, segment=1, start=goals)
+    assert abs(row["start"] - lbgp) < 1e-3
+    assert row["best"] >= row["start"] and row["rollouts"] == 4

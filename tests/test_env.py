@@ -176,3 +176,31 @@ def test_bad_person_path_names_the_problem(tmp_path):
     f.write_text("x,y\n0,0\n")
     with pytest.raises(PathError, match="at least two points"):
         make_env("straight", person_path=f)
+
+
+@pytest.mark.parametrize("level", ["straight_ahead", "turning_ahead"])
+def test_the_planner_sees_the_persons_true_speed_and_turn_rate_at_every_call(level):
+    """Both planner calls of an agent step (at its start and in its middle) get the person's
+    velocity over the same 0.2 s window, as the deploy loop computes it. (The middle call once
+    divided 0.3 s of motion by 0.2 s: the person seemed 1.5 x as fast every other call, and the
+    robot closed in on a person it overtook.)"""
+    env = make_env(level, robot="jackal", seed=0)
+    task = env.task
+    seen = []
+    command = task.controller.command
+
+    def spy(state):
+        seen.append((float(np.hypot(*state.person_velocity)), state.person_turn_rate))
+        return command(state)
+
+    task.controller.command = spy
+    env.reset()
+    for _ in range(6):
+        env.step(np.zeros(2))
+    v_true, w_true = task.person_cmd
+    assert len(seen) == 12  # two planner calls per agent step
+    speeds, turns = np.array(seen[3:]).T  # after the first 0.2 s window has filled
+    chord = np.sinc(w_true * 0.2 / (2 * np.pi))  # a turning person's 0.2 s chord is a little shorter than its arc
+    np.testing.assert_allclose(speeds, v_true * chord, rtol=1e-6)
+    np.testing.assert_allclose(turns, w_true, rtol=1e-6, atol=1e-9)
+    assert seen[0] == (0.0, 0.0)  # nothing to difference at the episode's first call

@@ -8,6 +8,7 @@ actuators by a controller (goal -> planner -> (v, w), or (v, w) directly).
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import math
 from typing import Callable
@@ -292,7 +293,7 @@ class FollowAheadTask(control.Task):
         self.rng = random if isinstance(random, np.random.Generator) else np.random.default_rng(random)
         self.person_pose = np.zeros(3)
         self.person_cmd = (0.0, 0.0)
-        self._prev_person_pose = np.zeros(3)
+        self._person_track: collections.deque = collections.deque(maxlen=16)  # (t, person pose) as moved
         self.time = 0.0
         self.contact = False
         self.last_command = Command(0.0, 0.0)
@@ -301,7 +302,8 @@ class FollowAheadTask(control.Task):
     def initialize_episode(self, physics: Physics) -> None:
         yaw = float(self.rng.uniform(-math.pi, math.pi)) if self.setting.random_person_heading else 0.0
         self.person_pose = self.motion.reset(self.rng, np.array([0.0, 0.0, yaw]))
-        self._prev_person_pose = self.person_pose.copy()
+        self._person_track.clear()
+        self._person_track.append((0.0, self.person_pose.copy()))
         if self.setting.spawn is None:
             distance = float(self.rng.uniform(*SPAWN_DISTANCE))
             alpha = float(self.rng.uniform(-math.pi / 2, math.pi / 2))  # in front of the person ...
@@ -343,9 +345,19 @@ class FollowAheadTask(control.Task):
         physics.set_robot_pose(pose_from_polar(self.person_pose, distance, alpha, relative_yaw))
 
     # -- world state (what the observation and the controller see)
+    def person_motion(self) -> tuple[np.ndarray, float]:
+        """The person's velocity and turn rate by finite difference over one agent period, the same
+        rule as the deploy loop (``lbgp.real.loop``): from the latest pose at least 0.2 s older than
+        the current one (the oldest at an episode's start) to the current one, over the time between.
+        Planner calls fall at the start and in the middle of an agent step; both see the same window."""
+        t_now, now = self._person_track[-1]
+        older = [(t, p) for t, p in self._person_track if t <= t_now - CONTROL_PERIOD + 1e-9]
+        t0, p0 = older[-1] if older else self._person_track[0]
+        return (obs_lib.estimate_person_velocity(p0, now, t_now - t0),
+                obs_lib.estimate_person_turn_rate(p0, now, t_now - t0))
+
     def world_state(self, physics: Physics) -> WorldState:
-        person_velocity = obs_lib.estimate_person_velocity(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
-        turn_rate = obs_lib.estimate_person_turn_rate(self._prev_person_pose, self.person_pose, CONTROL_PERIOD)
+        person_velocity, turn_rate = self.person_motion()
         # the robot's velocity is the last command, as on the real robot (lbgp.real.loop): the
         # planner's acceleration limits chain from command to command, not from the measured
         # velocity (a skid-steer base overshoots its yaw rate at speed; chaining from that
@@ -381,6 +393,7 @@ class FollowAheadTask(control.Task):
         into the current agent step, then ``substeps`` physics steps; returns whether robot and
         person touched."""
         self.move_person(physics, self.person_pose_at(phase))
+        self._person_track.append((self.time + phase, self.person_pose.copy()))
         physics.step_physics(substeps)
         return physics.robot_person_contact()
 
@@ -391,7 +404,6 @@ class FollowAheadTask(control.Task):
 
     def after_step(self, physics: Physics) -> None:
         self.time += CONTROL_PERIOD
-        self._prev_person_pose = self._step_start_pose
         self.stack.push(physics.robot_pose(), self.person_pose)
         self.person_cmd = self.motion.command(self.person_pose, CONTROL_PERIOD)
 

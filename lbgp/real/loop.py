@@ -131,12 +131,8 @@ class DeployLoop:
     # ------------------------------------------------------------------ one tick
     def _person_motion(self, frame) -> tuple[np.ndarray, float]:
         """Velocity and turn rate by finite difference over about one agent period of source time,
-        as in simulation."""
-        target = frame.t - obs_lib.FRAME_PERIOD
-        older = [(t, p) for t, p in self._people if t <= target + 1e-6]
-        t0, p0 = older[-1] if older else self._people[0]
-        return (obs_lib.estimate_person_velocity(p0, frame.person, frame.t - t0),
-                obs_lib.estimate_person_turn_rate(p0, frame.person, frame.t - t0))
+        by the simulator's rule (``obs_lib.estimate_person_motion``)."""
+        return obs_lib.estimate_person_motion(self._people, frame.t, frame.person)
 
     def _stop_command(self) -> tuple[float, float]:
         """Towards zero at the emergency deceleration (limit -> 0 in ``stop_time``)."""

@@ -106,6 +106,16 @@ def unscale(obs: np.ndarray) -> np.ndarray:
     return (np.asarray(obs, dtype=float).reshape(-1, 3) / _INV_SCALE).ravel()
 
 
+def estimate_person_motion(track, t_now: float, pose, period: float = FRAME_PERIOD) -> tuple[np.ndarray, float]:
+    """Person world velocity (vx, vy) and yaw rate by finite difference over about ``period``
+    seconds: from the latest pose in ``track`` (an oldest-first sequence of (t, pose)) that is at
+    least ``period`` older than ``pose`` at ``t_now`` (the oldest one while none is) to ``pose``.
+    The one rule of the simulator (``FollowAheadTask``) and the deploy loop (``lbgp.real.loop``)."""
+    older = [(t, p) for t, p in track if t <= t_now - period + 1e-6]
+    t0, p0 = older[-1] if older else track[0]
+    return estimate_person_velocity(p0, pose, t_now - t0), estimate_person_turn_rate(p0, pose, t_now - t0)
+
+
 def estimate_person_turn_rate(prev_pose, pose, dt: float) -> float:
     """Person yaw rate (rad/s) by finite difference of two poses ``dt`` seconds apart."""
     if dt <= 0:

@@ -346,15 +346,11 @@ class FollowAheadTask(control.Task):
 
     # -- world state (what the observation and the controller see)
     def person_motion(self) -> tuple[np.ndarray, float]:
-        """The person's velocity and turn rate by finite difference over one agent period, the same
-        rule as the deploy loop (``lbgp.real.loop``): from the latest pose at least 0.2 s older than
-        the current one (the oldest at an episode's start) to the current one, over the time between.
-        Planner calls fall at the start and in the middle of an agent step; both see the same window."""
+        """The person's velocity and turn rate over one agent period, by the deploy loop's rule
+        (``obs_lib.estimate_person_motion``). Planner calls fall at the start and in the middle of
+        an agent step; both see a 0.2 s window."""
         t_now, now = self._person_track[-1]
-        older = [(t, p) for t, p in self._person_track if t <= t_now - CONTROL_PERIOD + 1e-9]
-        t0, p0 = older[-1] if older else self._person_track[0]
-        return (obs_lib.estimate_person_velocity(p0, now, t_now - t0),
-                obs_lib.estimate_person_turn_rate(p0, now, t_now - t0))
+        return obs_lib.estimate_person_motion(self._person_track, t_now, now, CONTROL_PERIOD)
 
     def world_state(self, physics: Physics) -> WorldState:
         person_velocity, turn_rate = self.person_motion()

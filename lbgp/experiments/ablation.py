@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from lbgp.files import write_json
+from lbgp.metrics import reward_ci95
 
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.train import train
@@ -34,15 +35,13 @@ DEFAULT_RUNS_DIR = Path("runs") / "ablation"
 def final_returns(summaries: dict, labels: dict) -> dict:
     """Per variant: each seed's mean exploit return over its last 20 episodes, their mean and the
     95 % confidence interval's half-width (t over the seeds; None with one seed)."""
-    from scipy import stats
-
     out = {}
     for label in dict.fromkeys(labels.values()):
         values = [summaries[run].get("final_exploit_return_mean_last20") for run, lab in labels.items() if lab == label]
         values = [float(v) for v in values if v is not None]
         if not values:
             continue
-        half = float(stats.t.ppf(0.975, len(values) - 1) * np.std(values, ddof=1) / np.sqrt(len(values))) if len(values) > 1 else None
+        half = reward_ci95(values) if len(values) > 1 else None
         out[label] = {"per_seed": values, "mean": float(np.mean(values)), "ci95_half_width": half}
     return out
 

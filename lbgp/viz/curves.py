@@ -19,7 +19,7 @@ def _label(run_dir: Path) -> str:
     return name
 
 
-X_AXES = {"env_steps": "environment steps", "wall_time": "wall time (s)"}
+X_AXES = {"env_steps": ("env_steps", "environment steps"), "wall_time": ("wall_time_s", "wall time (s)")}  # curve.csv column, label
 BANDS = ("half_std", "ci95")
 
 
@@ -31,7 +31,7 @@ def smoothed_curve(run_dir: Path, grid: np.ndarray, window: int = 10, x: str = "
     rows = read_curve(run_dir / "curve.csv")
     if not rows:
         raise ValueError(f"{run_dir}: curve.csv holds no learning-curve points")
-    steps = np.array([r["env_steps" if x == "env_steps" else "wall_time_s"] for r in rows], float)
+    steps = np.array([r[X_AXES[x][0]] for r in rows], float)
     ret = np.array([r["exploit_return"] for r in rows], float)
     kernel = np.ones(min(window, len(ret))) / min(window, len(ret))
     smooth = np.convolve(ret, kernel, mode="valid")
@@ -85,7 +85,7 @@ def plot_learning_curves(run_dirs, out, labels=None, x: str = "env_steps", band:
         groups.setdefault(lab, []).append(d)
     from lbgp.agent.train import read_curve
 
-    column = "env_steps" if x == "env_steps" else "wall_time_s"
+    column, axis_label = X_AXES[x]
     longest = max(read_curve(d / "curve.csv")[-1][column] for d in dirs if read_curve(d / "curve.csv"))
     grid = np.linspace(0, longest, 200)
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -95,7 +95,7 @@ def plot_learning_curves(run_dirs, out, labels=None, x: str = "env_steps", band:
         mean, half = curve_band(curves[:, covered], band)
         ax.plot(grid[covered], mean, label=f"{lab} ({len(ds)} run{'s' if len(ds) > 1 else ''})")
         ax.fill_between(grid[covered], mean - half, mean + half, alpha=0.25)
-    ax.set_xlabel(X_AXES[x])
+    ax.set_xlabel(axis_label)
     ax.set_ylabel("exploit episode return (35 steps)")
     shade = "half a standard deviation" if band == "half_std" else "95 % confidence interval of the mean"
     ax.set_title(f"Learning curves (shaded: {shade})")

@@ -3,6 +3,8 @@
     python benchmarks/goal_ceiling.py --json results/goal_ceiling.json
     python benchmarks/goal_ceiling.py --start-from lbgp --segment 1 --std 0.15 --iterations 10 \
         --scenarios turning_ahead,... --json results/goal_ceiling_refined.json
+    python benchmarks/goal_ceiling.py --levels straight,circles,smoothed,trajectories --episodes 8 \
+        --start-from lbgp --json results/goal_ceiling_levels.json
 
 ``lbgp.experiments.ceiling`` bounds every method from above with a relaxed point robot (no heading,
 no acceleration limit); it says nothing about what the TEB planner and the real base let a *goal*
@@ -13,6 +15,12 @@ a time (default 7 segments of 1 s in a 35-step episode), and the cross-entropy m
 those numbers (population 24, 6 elites, 8 iterations), started from the constant goal 1.5 m ahead
 or (``--start-from lbgp``) from the goals the shipped LBGP asks for in the same episode, whose
 open-loop replay is that very episode.
+
+With ``--levels`` the same search runs on training-level episodes (random spawn 1-2.5 m around
+the person, half of them behind, random person motion), each seeded as ``lbgp evaluate`` seeds it
+and replayed noise-free; per level the mean over the episodes of each return is set against the
+level's point-robot ceiling (``results/reward_ceiling.json``, as ``benchmarks/levels_vs_ceiling.py``
+reads it): what share of it a goal policy can reach through this planner and robot.
 
 An open-loop sequence tuned to one deterministic episode knows the future, which no policy does,
 so its return is an optimistic target for LBGP; the search is not exhaustive either, so it is a
@@ -38,7 +46,8 @@ from lbgp.actions import DESIRED_GOAL, GOAL_X, GOAL_Y, action_from_goal, goal_fr
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
-from lbgp.sim import make_env  # noqa: E402
+from lbgp.files import read_json  # noqa: E402
+from lbgp.sim import level_names, make_env  # noqa: E402
 from lbgp.sim.tasks import DEFAULT_HORIZON, SCENARIOS  # noqa: E402
 
 TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
@@ -83,27 +92,35 @@ class RecordingPolicy:
         return action
 
 
-def closed_loop_goals(scenario: str, method: str, robot: str = "jackal") -> tuple[float, np.ndarray]:
-    """A closed-loop method's return on the noise-free scenario episode and the goals it asked for."""
+def play(env, episode, policy) -> float:
+    """One noise-free episode's return: a paper scenario's (fixed start; ``episode`` None) or a
+    training level's seeded one (``episode``: the seed ``lbgp evaluate`` gives it, e.g. [0, k, i]:
+    random spawn and person motion), replayed identically on every call."""
+    if episode is not None:
+        env.reseed(list(episode))
+    return float(run_episode(env, policy).total_reward)
+
+
+def closed_loop_goals(scenario: str, method: str, robot: str = "jackal", episode=None) -> tuple[float, np.ndarray]:
+    """A closed-loop method's return on the noise-free episode and the goals it asked for."""
     policy = RecordingPolicy(make_policy(method, robot=robot, transfer=True))
-    total = run_episode(make_env(scenario, robot=robot, seed=0, obs_noise=False), policy).total_reward
-    return float(total), np.array(policy.goals)
+    return play(make_env(scenario, robot=robot, seed=0, obs_noise=False), episode, policy), np.array(policy.goals)
 
 
 def search(scenario: str, robot: str = "jackal", segment: int = 5, population: int = 24, elites: int = 6,
-           iterations: int = 8, std: float = 0.4, seed: int = 0, start=None) -> dict:
-    """Cross-entropy search over one scenario's goal sequence; returns the best sequence and its return.
+           iterations: int = 8, std: float = 0.4, seed: int = 0, start=None, episode=None) -> dict:
+    """Cross-entropy search over one episode's goal sequence; returns the best sequence and its return.
 
     ``start``: a per-step goal sequence (35, 2) to start from (e.g. a closed-loop method's goals,
     whose open-loop replay is the same episode), averaged over each segment; default the constant
-    goal 1.5 m ahead."""
+    goal 1.5 m ahead. ``episode``: a training level's episode seed (``episode_env``)."""
     env = make_env(scenario, robot=robot, seed=0, obs_noise=False)
     rng = np.random.default_rng(seed)
     segments = -(-DEFAULT_HORIZON // segment)
     lo, hi = np.array([GOAL_X[0], GOAL_Y[0]]), np.array([GOAL_X[1], GOAL_Y[1]])
 
     def score(goals):
-        return run_episode(env, GoalSequencePolicy(goals, segment)).total_reward
+        return play(env, episode, GoalSequencePolicy(goals, segment))
 
     constant = score(np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1)))
     if start is None:
@@ -131,18 +148,32 @@ def search(scenario: str, robot: str = "jackal", segment: int = 5, population: i
 
 
 def one(args) -> dict:
-    scenario, robot, start_from, kwargs = args
-    from lbgp.experiments.ceiling import scenario_ceiling
-
-    hc, _ = closed_loop_goals(scenario, "hc", robot)
-    lbgp, lbgp_goals = closed_loop_goals(scenario, "lbgp", robot)
-    row = search(scenario, robot, start=lbgp_goals if start_from == "lbgp" else None, **kwargs)
+    scenario, robot, start_from, kwargs, episode = args
+    hc, _ = closed_loop_goals(scenario, "hc", robot, episode)
+    lbgp, lbgp_goals = closed_loop_goals(scenario, "lbgp", robot, episode)
+    row = search(scenario, robot, start=lbgp_goals if start_from == "lbgp" else None, episode=episode, **kwargs)
     row["start_from"] = start_from
     row["hc"], row["lbgp"] = hc, lbgp
-    row["point_robot_ceiling"] = scenario_ceiling(scenario, planner_config_for(robot).max_vel_x)
-    print(f"{scenario}: searched {row['best']:.2f}  constant {row['constant_1_5']:.2f}  HC {row['hc']:.2f}  "
-          f"LBGP {row['lbgp']:.2f}  point robot {row['point_robot_ceiling']:.2f}", flush=True)
+    if episode is None:
+        from lbgp.experiments.ceiling import scenario_ceiling
+
+        row["point_robot_ceiling"] = scenario_ceiling(scenario, planner_config_for(robot).max_vel_x)
+    else:
+        row["episode"] = list(episode)
+    print(f"{scenario}{'' if episode is None else f' {list(episode)}'}: searched {row['best']:.2f}  constant "
+          f"{row['constant_1_5']:.2f}  HC {row['hc']:.2f}  LBGP {row['lbgp']:.2f}", flush=True)
     return row
+
+
+def level_summary(rows: list, ceiling: float) -> dict:
+    """Mean over a level's episodes of each return, and its share of the level's point-robot ceiling.
+    ``best_known``: per episode the best of the search, the constant goal, HC and LBGP (each a goal
+    sequence that replays to its return)."""
+    for r in rows:
+        r["best_known"] = max(r["best"], r["constant_1_5"], r["hc"], r["lbgp"])
+    means = {k: round(float(np.mean([r[k] for r in rows])), 3) for k in ("best_known", "best", "constant_1_5", "hc", "lbgp")}
+    return {"mean": means, "point_robot_ceiling": round(ceiling, 3),
+            "share_of_ceiling": {k: round(v / ceiling, 3) for k, v in means.items()}, "episodes": rows}
 
 
 def main(argv=None) -> dict:
@@ -150,6 +181,10 @@ def main(argv=None) -> dict:
     p.add_argument("--json", default="results/goal_ceiling.json")
     p.add_argument("--robot", default="jackal", choices=("jackal", "turtlebot2"))
     p.add_argument("--scenarios", default=",".join(SCENARIOS))
+    p.add_argument("--levels", default="", help="training levels to search instead of scenarios (e.g. straight,circles)")
+    p.add_argument("--episodes", type=int, default=8, help="seeded episodes per level (with --levels)")
+    p.add_argument("--seed", type=int, default=0, help="episode i of level k is seeded [seed, k, i], as lbgp evaluate does")
+    p.add_argument("--ceiling", default="results/reward_ceiling.json", help="the levels' point-robot ceilings (with --levels)")
     p.add_argument("--iterations", type=int, default=8)
     p.add_argument("--population", type=int, default=24)
     p.add_argument("--segment", type=int, default=5, help="agent steps each goal is held")
@@ -158,17 +193,35 @@ def main(argv=None) -> dict:
                    help="start the search at the constant goal 1.5 m ahead or at the shipped LBGP's goals")
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
     args = p.parse_args(argv)
-    scenarios = [s for s in args.scenarios.split(",") if s]
     kwargs = dict(iterations=args.iterations, population=args.population, segment=args.segment, std=args.std)
-    jobs = [(s, args.robot, args.start_from, kwargs) for s in scenarios]
+    settings = {**kwargs, "start_from": args.start_from}
+    if args.levels:
+        all_levels = level_names()
+        levels = [name for name in args.levels.split(",") if name]
+        unknown = sorted(set(levels) - set(all_levels))
+        if unknown:
+            p.error(f"unknown levels {unknown}; use {', '.join(all_levels)}")
+        # the ceilings as benchmarks/levels_vs_ceiling.py reads them (the file's last row per level)
+        ceilings = {r["level"]: r["mean_bound"] for r in read_json(args.ceiling, "reward ceiling")["results"]}
+        jobs = [(name, args.robot, args.start_from, kwargs, (args.seed, all_levels.index(name), i))
+                for name in levels for i in range(args.episodes)]
+    else:
+        jobs = [(s, args.robot, args.start_from, kwargs, None) for s in args.scenarios.split(",") if s]
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        rows = dict(zip(scenarios, pool.map(one, jobs, chunksize=1)))
+        done = pool.map(one, jobs, chunksize=1)
+    if args.levels:
+        rows = {name: level_summary([r for j, r in zip(jobs, done) if j[0] == name], ceilings[name]) for name in levels}
+        result = {"benchmark": "goal_ceiling_levels", "robot": args.robot, "settings": {**settings, "episodes": args.episodes},
+                  "command": "python benchmarks/goal_ceiling.py " + " ".join(sys.argv[1:] if argv is None else argv), "levels": rows}
+        write_result(args.json, result)
+        return result
+    rows = {j[0]: r for j, r in zip(jobs, done)}
     sums = {}
     for group, names in (("turning", TURNING), ("trajectories", TRAJECTORIES)):
         if all(n in rows for n in names):
             sums[group] = {k: round(sum(rows[n][k] for n in names), 2)
                            for k in ("best", "constant_1_5", "hc", "lbgp", "point_robot_ceiling")}
-    result = {"benchmark": "goal_ceiling", "robot": args.robot, "settings": {**kwargs, "start_from": args.start_from}, "scenarios": rows, "sums": sums}
+    result = {"benchmark": "goal_ceiling", "robot": args.robot, "settings": settings, "scenarios": rows, "sums": sums}
     write_result(args.json, result)
     return result
 

@@ -41,3 +41,17 @@ def test_a_search_started_from_lbgps_goals_starts_at_lbgps_closed_loop_return():
     row = search("turning_inside", population=2, elites=1, iterations=1, segment=1, start=goals)
     assert abs(row["start"] - lbgp) < 1e-3
     assert row["best"] >= row["start"] and row["rollouts"] == 4
+
+
+def test_a_training_level_episode_is_searched_and_replayed_by_its_seed():
+    """--levels: a random-spawn episode is pinned by its evaluation seed, so the searched goals
+    replay to the same return, and another seed is another episode."""
+    episode = (0, 1, 3)
+    row = search("circles", population=2, elites=1, iterations=1, segment=7, episode=episode)
+    env = make_env("circles", robot="jackal", seed=0, obs_noise=False)
+    env.reseed(list(episode))
+    replay = run_episode(env, GoalSequencePolicy(row["goals"], 7)).total_reward
+    assert abs(replay - row["best"]) < 1e-6
+    env.reseed([0, 1, 4])
+    other = run_episode(env, GoalSequencePolicy(row["goals"], 7)).total_reward
+    assert abs(other - row["best"]) > 1e-3

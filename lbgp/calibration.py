@@ -45,6 +45,12 @@ class CommandCalibration:
     def is_identity(self) -> bool:
         return self.scale_v == 1.0 and self.scale_w == 1.0
 
+    def reset(self) -> None:
+        """Nothing to forget (``lbgp.online_calibration.OnlineCalibration`` has the same calls)."""
+
+    def observe(self, t: float, pose) -> None:
+        """A fixed calibration does not learn from the robot's measured poses."""
+
     def apply(self, v: float, w: float) -> tuple[float, float]:
         """The command to send for the wanted (v, w)."""
         return v * self.scale_v, w * self.scale_w
@@ -64,13 +70,19 @@ class CommandCalibration:
         return cls(ref_v / gain_v, ref_w / gain_w, source or "gains")
 
 
-def load_calibration(spec, robot: str) -> CommandCalibration:
-    """``None`` or ``"none"``: the identity; a ``CommandCalibration``; or a JSON file: the output of
+def load_calibration(spec, robot: str):
+    """``None`` or ``"none"``: the identity; ``"online"``: a fresh ``OnlineCalibration`` (gains
+    estimated while driving, ``lbgp.online_calibration``); a ``CommandCalibration`` or an
+    ``OnlineCalibration`` as it is; or a JSON file: the output of
     ``lbgp sysid --out`` (its ``fit.gain_v`` / ``fit.gain_w``, taken relative to the simulated
     robot's) or ``{"scale_v": ..., "scale_w": ...}`` (multipliers as they are)."""
     if spec is None or spec == "none":
         return CommandCalibration()
-    if isinstance(spec, CommandCalibration):
+    if spec == "online":
+        from lbgp.online_calibration import OnlineCalibration
+
+        return OnlineCalibration(robot)
+    if isinstance(spec, CommandCalibration) or hasattr(spec, "observe"):
         return spec
     path = Path(spec)
     data = read_json(path, "calibration")

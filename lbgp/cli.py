@@ -323,7 +323,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
                    help="robot dynamics: nominal (default), hardware_like, or a JSON file (e.g. from lbgp sysid)")
     p.add_argument("--calibration", type=A.calibration_spec, default=None,
-                   help="command calibration: none (default) or lbgp sysid's JSON (commands scaled so the robot answers like the simulated one)")
+                   help="command calibration: none (default), online (the robot's gains estimated while driving) or lbgp sysid's JSON "
+                        "(commands scaled so the robot answers like the simulated one)")
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -404,7 +405,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
                    help="simulated robot only (--source sim): nominal (default), hardware_like, or a JSON file")
     p.add_argument("--calibration", type=A.calibration_spec, default=None,
-                   help="command calibration: none (default) or lbgp sysid's JSON for this robot (every command sent is scaled by it)")
+                   help="command calibration: none (default), online (the robot's gains estimated while driving) or lbgp sysid's JSON "
+                        "for this robot (every command sent is scaled by it)")
     p.set_defaults(func=cmd_deploy)
 
     p = sub.add_parser("sysid", help="identify a robot's dynamics from a deploy log (or --excite: record one)")

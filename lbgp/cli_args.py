@@ -84,13 +84,14 @@ def dynamics_spec(text: str) -> str:
 
 
 def calibration_spec(text: str) -> str:
-    """``none`` or an existing JSON file (``lbgp sysid``'s output, or scale_v / scale_w)."""
-    if text == "none":
+    """``none``, ``online`` (gains estimated while driving) or an existing JSON file (``lbgp sysid``'s
+    output, or scale_v / scale_w)."""
+    if text in ("none", "online"):
         return text
     try:
         return input_file(text)
     except argparse.ArgumentTypeError as exc:
-        raise argparse.ArgumentTypeError(f"{exc}; use none or the JSON that lbgp sysid --out wrote") from None
+        raise argparse.ArgumentTypeError(f"{exc}; use none, online or the JSON that lbgp sysid --out wrote") from None
 
 
 def randomize_spec(text: str) -> str:

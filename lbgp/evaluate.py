@@ -10,6 +10,7 @@ see ``lbgp.metrics.LoopDetector``)``.
 
 from __future__ import annotations
 
+from lbgp.calibration import load_calibration
 from lbgp.metrics import aggregate
 from lbgp.rollout import run_episode
 from lbgp.sim import make_env
@@ -35,7 +36,10 @@ def evaluate(policy, method: str, names: list[str], robot: str = "jackal", episo
     """Episode i of scenario k is seeded with (seed, k, i): every method faces the same episodes.
     ``obs_noise``: the observation noise on/off (default: on for levels, off for scenarios).
     ``dynamics``: the robot's dynamics (``lbgp.dynamics``: a name, a JSON file or a ``Dynamics``; default nominal).
-    ``calibration``: the command calibration (``lbgp.calibration``; default none)."""
+    ``calibration``: the command calibration (``lbgp.calibration``; default none); ``"online"``: one
+    online estimator (``lbgp.online_calibration``) for all the episodes, in order, as one robot
+    doing every run keeps what it learned."""
+    calibration = load_calibration(calibration, robot)
     results = []
     for k, name in enumerate(names):
         env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path,

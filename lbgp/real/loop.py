@@ -30,6 +30,7 @@ import numpy as np
 
 from lbgp import stack
 from lbgp.calibration import CommandCalibration
+from lbgp.online_calibration import OnlineCalibration
 from lbgp.conventions import PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha
 from lbgp.metrics import EpisodeMetrics
@@ -78,7 +79,8 @@ class DeployConfig:
     end_distance: float | None = None  # end the run when D exceeds this after having been within it (paper: 3 m)
     first_pose_timeout: float | None = None  # s: end the run ("no_pose") if no valid pose arrived by then
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
-    calibration: CommandCalibration = dataclasses.field(default_factory=CommandCalibration)  # applied to every command sent
+    # applied to every command sent: fixed (lbgp sysid's gains) or estimated while driving (OnlineCalibration)
+    calibration: CommandCalibration | OnlineCalibration = dataclasses.field(default_factory=CommandCalibration)
 
 
 @dataclasses.dataclass
@@ -111,6 +113,7 @@ class DeployLoop:
         self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
         self.limits = stack.planner_limits(self.cfg.robot, self.cfg.planner_period, time_budget=self.cfg.planner_time_budget)
         self.controller = stack.make_controller(policy.control, self.limits)
+        self.cfg.calibration.reset()  # an online calibration starts each run afresh
         self.monitor = SafetyMonitor(self.cfg.safety)
         self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance
         self.stack = obs_lib.ObservationStack()
@@ -180,6 +183,8 @@ class DeployLoop:
         else:
             v, w = self._stop_command()
         self.command = (v, w)  # the planner's limits chain from its own command, before calibration
+        if status == safety_lib.OK:
+            self.cfg.calibration.observe(frame.t, frame.robot)  # an online calibration learns from the measured motion
         v, w = self.cfg.calibration.apply(v, w)
         # the robot side sees why it is being stopped: a safety reason, or the planner's safe stop
         self.sink.send(now, v, w, status if record.planner_status in ("", safety_lib.OK) else record.planner_status)

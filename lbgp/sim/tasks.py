@@ -321,6 +321,7 @@ class FollowAheadTask(control.Task):
         self.time = 0.0
         self.contact = False
         self.controller.reset()
+        self.calibration.reset()
         self.last_command = Command(0.0, 0.0)
         self.stack.reset(physics.robot_pose(), self.person_pose)
         self.person_cmd = self.motion.command(self.person_pose, CONTROL_PERIOD)
@@ -369,6 +370,7 @@ class FollowAheadTask(control.Task):
     def apply_command(self, physics: Physics) -> Command:
         """One controller tick: (v, w) from the controller, to wheel speeds."""
         self.last_command = self.controller.command(self.world_state(physics))
+        self.calibration.observe(float(physics.data.time), physics.robot_pose())  # an online calibration learns from it
         physics.drive_wheels(*self.calibration.apply(self.last_command.v, self.last_command.w))
         return self.last_command
 

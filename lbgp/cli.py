@@ -160,6 +160,8 @@ def cmd_deploy(args) -> int:
             signal.signal(sig, handler)
     summary = {"end": loop.end_reason, "ticks": loop.ticks, "agent_steps": loop.agent_steps, **loop.metrics.summary(),
                "rejected_frames": loop.monitor.counts}
+    if hasattr(loop.cfg.calibration, "gains"):  # --calibration online: what it learned about the robot
+        summary["calibration"] = {**loop.cfg.calibration.to_dict(), "gains": loop.cfg.calibration.gains}
     if loop.error is not None:
         summary["error"] = f"{type(loop.error).__name__}: {loop.error}"
     print(json.dumps(summary, indent=2))

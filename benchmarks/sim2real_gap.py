@@ -1,7 +1,7 @@
 """Each method's reward on the nominal robot model vs the held-out hardware-like one (lbgp.dynamics).
 
     python benchmarks/sim2real_gap.py --json results/sim2real_gap.json [--episodes 10] [--repeats 5]
-        [--e2e-randomized runs/e2e_rand/policy.pt] [--lbgp-policy FILE] [--methods lbgp,hc,e2e,e2e_randomized]
+        [--e2e-randomized runs/e2e_rand/policy.pt] [--lbgp-policy FILE] [--methods lbgp,hc,e2e,e2e_randomized] [--jobs 2]
 
 Two parts, the same seeds for every method and both dynamics:
 * the paper's 9 simulation scenarios on the Jackal (``lbgp evaluate``'s episodes, observation noise on);
@@ -14,7 +14,11 @@ share kept on the hardware-like robot. Target (sim2real issue): LBGP keeps >= 85
 A third column, ``hardware_like_calibrated``, is the hardware-like robot driven through a command
 calibration (``lbgp.calibration``) made the way a user would make it: ``lbgp sysid --excite`` on
 that robot (simulated mocap, seed 1), ``lbgp sysid`` on the log, and the identified gains relative
-to the simulated robot's. The benchmark runs those two steps itself. An E2E policy
+to the simulated robot's. The benchmark runs those two steps itself. Two more, ``nominal_online``
+and ``hardware_like_online``, drive through the online calibration (``--calibration online``,
+``lbgp.online_calibration``): no identification run; one estimator per robot and column, carried
+from run to run in the order below (the first episode starts from nothing), as one robot doing
+every run would keep what it learned. An E2E policy
 trained with domain randomisation (``lbgp train --method e2e --randomize default``) is reported
 beside the shipped one when ``--e2e-randomized`` names it.
 """
@@ -22,6 +26,8 @@ beside the shipped one when ``--e2e-randomized`` names it.
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
+import math
 import sys
 import tempfile
 import time
@@ -34,6 +40,8 @@ from _common import write_result  # noqa: E402
 
 from lbgp.calibration import CommandCalibration  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
+from lbgp.metrics import reward_ci95  # noqa: E402
+from lbgp.online_calibration import OnlineCalibration  # noqa: E402
 from lbgp.experiments.real_protocol import PATHS, SETTINGS, run_setting  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.real.sysid import identify, record_excitation  # noqa: E402
@@ -41,6 +49,8 @@ from lbgp.sim import scenario_names  # noqa: E402
 
 
 CALIBRATED = "hardware_like_calibrated"
+ONLINE = ("nominal_online", "hardware_like_online")
+COLUMNS = ("nominal", "hardware_like", CALIBRATED, *ONLINE)
 
 
 def identified_calibration(robot: str) -> tuple[CommandCalibration, dict]:
@@ -54,37 +64,68 @@ def identified_calibration(robot: str) -> tuple[CommandCalibration, dict]:
                          "scale_v": round(calibration.scale_v, 4), "scale_w": round(calibration.scale_w, 4)}
 
 
-def runs_of(calibration: CommandCalibration):
-    """(column, dynamics, calibration) for the three columns."""
-    return [("nominal", "nominal", None), ("hardware_like", "hardware_like", None), (CALIBRATED, "hardware_like", calibration)]
+def runs_of(calibration: CommandCalibration, robot: str):
+    """(column, dynamics, calibration) for the five columns (a fresh online estimator for each)."""
+    return [("nominal", "nominal", None), ("hardware_like", "hardware_like", None), (CALIBRATED, "hardware_like", calibration),
+            ("nominal_online", "nominal", OnlineCalibration(robot)), ("hardware_like_online", "hardware_like", OnlineCalibration(robot))]
 
 
-def scenario_part(policy, method: str, episodes: int, seed: int, calibration: CommandCalibration) -> dict:
-    out = {}
-    for column, dynamics, cal in runs_of(calibration):
+def scenario_part(policy, method: str, episodes: int, seed: int, calibration: CommandCalibration) -> tuple[dict, dict]:
+    """Per column: each scenario's mean reward, and the half-width of its 95 % interval."""
+    means, half_widths = {}, {}
+    for column, dynamics, cal in runs_of(calibration, "jackal"):
         rows = evaluate(policy, method, scenario_names(), robot="jackal", episodes=episodes, seed=seed, obs_noise=True,
                         dynamics=dynamics, calibration=cal)
-        out[column] = {r["scenario"]: round(r["reward"], 3) for r in rows}
-    return out
+        means[column] = {r["scenario"]: round(r["reward"], 3) for r in rows}
+        half_widths[column] = {r["scenario"]: round(r["reward_ci95"], 3) for r in rows}
+    return means, half_widths
 
 
-def protocol_part(policy, repeats: int, steps: int, seed: int, calibration: CommandCalibration) -> dict:
-    out = {}
-    for column, dynamics, cal in runs_of(calibration):
-        rewards = {}
+def protocol_part(policy, repeats: int, steps: int, seed: int, calibration: CommandCalibration) -> tuple[dict, dict]:
+    """Per column: each setting's mean reward over ``repeats`` runs, and its 95 % half-width."""
+    means, half_widths = {}, {}
+    for column, dynamics, cal in runs_of(calibration, "turtlebot2"):
+        means[column], half_widths[column] = {}, {}
         for path in PATHS:
             for setting in SETTINGS[path]:
                 runs = [run_setting(policy, path, setting, steps, seed + r, dynamics=dynamics, calibration=cal) for r in range(repeats)]
-                rewards[f"{path}/{setting}"] = round(float(np.mean([m.total_reward for m in runs])), 3)
-        out[column] = rewards
+                rewards = [m.total_reward for m in runs]
+                means[column][f"{path}/{setting}"] = round(float(np.mean(rewards)), 3)
+                half_widths[column][f"{path}/{setting}"] = round(reward_ci95(rewards), 3)
+    return means, half_widths
+
+
+def totals(part: dict, half_widths: dict) -> dict:
+    """Each column's sum with the half-width of its 95 % interval (the rows' combined in quadrature),
+    and the share of the nominal robot's kept on the hardware-like one: ``kept`` (no calibration),
+    ``kept_calibrated`` (sysid's), ``kept_online`` (online, against the nominal robot driven through
+    the online calibration too), each with a 95 % half-width (``*_ci95``: the two sums' relative
+    half-widths in quadrature; conservative, as both columns run the same seeds)."""
+    sums = {c: sum(part[c].values()) for c in COLUMNS}
+    hw = {c: math.sqrt(sum(h**2 for h in half_widths[c].values())) for c in COLUMNS}
+    out = {**{c: round(v, 2) for c, v in sums.items()}, "ci95": {c: round(h, 2) for c, h in hw.items()}}
+    for name, a, b in (("kept", "hardware_like", "nominal"), ("kept_calibrated", CALIBRATED, "nominal"),
+                       ("kept_online", "hardware_like_online", "nominal_online")):
+        if sums[b] > 0 and sums[a] != 0:
+            ratio = sums[a] / sums[b]
+            out[name] = round(ratio, 3)
+            out[f"{name}_ci95"] = round(abs(ratio) * math.hypot(hw[a] / sums[a], hw[b] / sums[b]), 3)
+        else:
+            out[name] = out[f"{name}_ci95"] = None
     return out
 
 
-def totals(part: dict) -> dict:
-    nominal, hardware, calibrated = (sum(part[c].values()) for c in ("nominal", "hardware_like", CALIBRATED))
-    return {"nominal": round(nominal, 2), "hardware_like": round(hardware, 2), CALIBRATED: round(calibrated, 2),
-            "kept": round(hardware / nominal, 3) if nominal > 0 else None,
-            "kept_calibrated": round(calibrated / nominal, 3) if nominal > 0 else None}
+def method_result(job) -> tuple[str, dict]:
+    """Both parts for one method (a process of its own with ``--jobs``)."""
+    name, path, args, calibrations = job
+    method = "e2e" if name.startswith("e2e") else name
+    scen, scen_hw = scenario_part(make_policy(method, path, robot="jackal"), method, args.episodes, args.seed, calibrations["jackal"])
+    proto, proto_hw = protocol_part(make_policy(method, path, robot="turtlebot2", transfer=True), args.repeats, args.steps,
+                                    args.seed, calibrations["turtlebot2"])
+    scen_totals, proto_totals = totals(scen, scen_hw), totals(proto, proto_hw)
+    print(f"{name}: scenarios {scen_totals}, protocol {proto_totals}", file=sys.stderr, flush=True)
+    return name, {"scenarios": {**scen_totals, "per_scenario": scen, "per_scenario_ci95": scen_hw},
+                  "real_protocol": {**proto_totals, "per_setting": proto, "per_setting_ci95": proto_hw}}
 
 
 def main() -> None:
@@ -95,6 +136,7 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=60, help="agent steps per protocol run")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--e2e-randomized", help="an E2E policy trained with --randomize, reported as e2e_randomized")
+    ap.add_argument("--jobs", type=int, default=1, help="methods run in parallel processes (one core each)")
     ap.add_argument("--lbgp-policy", help="LBGP policy file (default: the shipped one)")
     ap.add_argument("--methods", default="lbgp,hc,e2e,e2e_randomized",
                     help="comma-separated subset of lbgp,hc,e2e,e2e_randomized (default: all; e2e_randomized needs --e2e-randomized)")
@@ -116,14 +158,14 @@ def main() -> None:
         calibrations[robot], identified[robot] = identified_calibration(robot)
     result["calibration"] = identified
     print(f"calibration: {identified}", file=sys.stderr, flush=True)
-    for name, path in methods.items():
-        method = "e2e" if name.startswith("e2e") else name
-        scen = scenario_part(make_policy(method, path, robot="jackal"), method, args.episodes, args.seed, calibrations["jackal"])
-        proto = protocol_part(make_policy(method, path, robot="turtlebot2", transfer=True), args.repeats, args.steps, args.seed,
-                              calibrations["turtlebot2"])
-        result["methods"][name] = {"scenarios": {**totals(scen), "per_scenario": scen},
-                                   "real_protocol": {**totals(proto), "per_setting": proto}}
-        print(f"{name}: scenarios {totals(scen)}, protocol {totals(proto)}", file=sys.stderr, flush=True)
+    jobs = [(name, path, args, calibrations) for name, path in methods.items()]
+    if args.jobs > 1:
+        with concurrent.futures.ProcessPoolExecutor(min(args.jobs, len(jobs))) as pool:
+            done = list(pool.map(method_result, jobs))
+    else:
+        done = [method_result(job) for job in jobs]
+    for name, entry in done:
+        result["methods"][name] = entry
     result["wall_time_s"] = round(time.perf_counter() - t0, 1)
     if not args.e2e_randomized and "e2e_randomized" in wanted:
         result["e2e_randomized"] = "not run: no randomised E2E policy given (--e2e-randomized)"

@@ -184,3 +184,20 @@ def test_the_reference_gains_are_what_the_estimator_sees_on_the_nominal_jackal()
     v, w = np.median(np.array(gains), axis=0)
     assert v == pytest.approx(REF_V, rel=0.03)
     assert w == pytest.approx(REF_W, rel=0.06)
+
+
+def test_the_deploy_log_records_the_scale_each_command_was_sent_with(tmp_path):
+    """--calibration online --log: every tick's /lbgp/status says the scale its /cmd_vel carries,
+    from 1 at the start to what the slippery hardware-like Jackal taught the estimator."""
+    import json
+
+    from lbgp.real.deploy import deploy
+    from lbgp.real.replay import replay_log
+
+    loop = deploy(ConstantGoalPolicy((1.5, 0.0)), source="sim://turning_outside", robot="jackal", steps=35,
+                  log=tmp_path / "run.mcap", dynamics="hardware_like", calibration="online")
+    _, log = replay_log(tmp_path / "run.mcap")
+    statuses = [json.loads(message.data) for _, message in log["/lbgp/status"]]
+    scales = [s["command_scale"][1] for s in statuses if "command_scale" in s]
+    assert scales[-1] == pytest.approx(loop.cfg.calibration.scale_w) and max(scales) > 1.15
+    assert "command_scale" not in statuses[0]  # nothing learned yet: the command went out as planned

@@ -101,6 +101,7 @@ class TickRecord:
     latency_s: float = math.nan  # from reading the newest frame to sending the command
     reward: float = math.nan  # agent steps only
     distance_alpha: tuple = (math.nan, math.nan)  # whenever the tick had good poses
+    command_scale: tuple = (1.0, 1.0)  # the calibration's (scale_v, scale_w) applied to this tick's command
 
 
 class DeployLoop:
@@ -186,6 +187,7 @@ class DeployLoop:
         if status == safety_lib.OK:
             self.cfg.calibration.observe(frame.t, frame.robot)  # an online calibration learns from the measured motion
         v, w = self.cfg.calibration.apply(v, w)
+        record.command_scale = (float(self.cfg.calibration.scale_v), float(self.cfg.calibration.scale_w))
         # the robot side sees why it is being stopped: a safety reason, or the planner's safe stop
         self.sink.send(now, v, w, status if record.planner_status in ("", safety_lib.OK) else record.planner_status)
         record.v, record.w = v, w  # what was sent (logged as /cmd_vel: identifying a calibrated run sees the raw base)

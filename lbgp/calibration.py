@@ -82,7 +82,7 @@ def load_calibration(spec, robot: str):
         from lbgp.online_calibration import OnlineCalibration
 
         return OnlineCalibration(robot)
-    if isinstance(spec, CommandCalibration) or hasattr(spec, "observe"):
+    if hasattr(spec, "observe"):  # a CommandCalibration or an OnlineCalibration: used as it is
         return spec
     path = Path(spec)
     data = read_json(path, "calibration")

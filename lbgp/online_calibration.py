@@ -98,7 +98,7 @@ class OnlineCalibration:
         self._sent: collections.deque = collections.deque(maxlen=self.LAGS)  # commands sent, newest first
         self._anchor: tuple[float, np.ndarray] | None = None
         self._sent_count = 0
-        self._chain: collections.deque = collections.deque(maxlen=self.SETTLE_SAMPLES + 1)  # (t0, t, achieved) of consecutive samples
+        self._chain: collections.deque = collections.deque(maxlen=self.SETTLE_SAMPLES + 1)  # (t, achieved) of consecutive samples
 
     def forget(self) -> None:
         """Start from nothing: no correction until the new robot's gains have been estimated."""
@@ -122,11 +122,11 @@ class OnlineCalibration:
                 mid = p0[2] + 0.5 * turn
                 forward = math.cos(mid) * (pose[0] - p0[0]) + math.sin(mid) * (pose[1] - p0[1])
                 achieved = np.array([forward / dt, turn / dt])
-                if self._chain and self._chain[-1][1] != t0:
+                if self._chain and self._chain[-1][0] != t0:
                     self._chain.clear()  # a gap: the chain of consecutive samples starts again
-                self._chain.append((t0, float(t), achieved))
+                self._chain.append((float(t), achieved))
                 # the motion SETTLE_SAMPLES samples earlier (nan if the chain is shorter)
-                earlier = self._chain[0][2] if len(self._chain) > self.SETTLE_SAMPLES else np.full(2, np.nan)
+                earlier = self._chain[0][1] if len(self._chain) > self.SETTLE_SAMPLES else np.full(2, np.nan)
                 self._samples.append((t, dt, np.array(self._sent), achieved, earlier))
                 self._update(t, dt)
         self._anchor, self._sent_count = (float(t), pose), 0

@@ -132,9 +132,8 @@ class McapLogger:
             self._write("/lbgp/observation", {"layout": {"dim": [{"label": "observation", "size": len(data), "stride": len(data)}],
                                                           "data_offset": 0}, "data": data}, ns)
         status = {"t": record.t, "status": record.status, "planner": record.planner_status, "agent_step": record.agent_step}
-        scale = getattr(record, "command_scale", (1.0, 1.0))
-        if tuple(scale) != (1.0, 1.0):  # a calibration scaled this tick's command (--calibration)
-            status["command_scale"] = [float(scale[0]), float(scale[1])]
+        if tuple(record.command_scale) != (1.0, 1.0):  # a calibration scaled this tick's command (--calibration)
+            status["command_scale"] = [float(x) for x in record.command_scale]
         self._write("/lbgp/status", {"data": json.dumps(status)}, ns)
         self._file.flush()  # complete chunks reach the disk as soon as they are written
 

@@ -228,9 +228,12 @@ def cmd_experiment(args) -> int:
         from lbgp.experiments.ablation import run_ablation
 
         report = run_ablation(args.out, minutes=args.minutes, seeds=args.seeds, steps=args.max_steps, backend=args.backend,
-                              runs_dir=args.runs_dir, command=command)
+                              runs_dir=args.runs_dir, command=command, max_new_runs=args.max_new_runs)
         print(json.dumps({k: v.get("final_exploit_return_mean_last20") for k, v in report["runs"].items()}, indent=2))
-        print(f"wrote {Path(args.out, 'ablation_curves.png')}")
+        if report["missing_runs"]:
+            print(f"not trained yet (run the same command again): {', '.join(report['missing_runs'])}")
+        if report["runs"]:
+            print(f"wrote {Path(args.out, 'ablation_curves.png')}")
     return 0
 
 
@@ -382,6 +385,8 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--max-steps", type=A.positive_int, help="also stop each run after this many env steps")
             q.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"])
             q.add_argument("--runs-dir", type=A.output_dir, help="where the training runs go (default: runs/ablation); runs found there resume")
+            q.add_argument("--max-new-runs", type=A.positive_int, help="train at most this many runs now; finished runs are kept in "
+                           "OUT/ablation_runs and reused, so the same command later trains the rest")
         q.set_defaults(func=cmd_experiment)
 
     p = sub.add_parser("deploy", help="run a policy on a robot (or the simulated one): poses in, commands out")

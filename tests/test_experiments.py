@@ -2,6 +2,8 @@
 pictures, the ablation figure."""
 
 import csv
+import json
+import shutil
 
 import numpy as np
 import pytest
@@ -83,11 +85,36 @@ def test_real_protocol_runs_through_the_deploy_loop_and_ends_far_runs(tmp_path):
 def test_ablation_on_a_tiny_budget(tmp_path):
     report = run_ablation(tmp_path, minutes=1.0, seeds=[0], steps=150, backend="inline", runs_dir=tmp_path / "runs")
     assert set(report["runs"]) == {"LBGP_s0", "LBGP-no-curriculum_s0", "E2E_s0"}
+    assert report["complete"] and report["missing_runs"] == []
     assert (tmp_path / "runs" / "E2E_s0" / "checkpoint.pt").is_file()
     assert set(report["final_returns"]) <= {"LBGP", "LBGP-no-curriculum", "E2E"}
     assert report["runs"]["LBGP-no-curriculum_s0"]["final_level"] == "trajectories"
     assert report["runs"]["E2E_s0"]["method"] == "e2e"
     assert (tmp_path / "ablation_curves.png").stat().st_size > 5_000
+    kept = tmp_path / "ablation_runs" / "E2E_s0"
+    assert sorted(p.name for p in kept.iterdir()) == ["config.json", "curve.csv", "summary.json"]
+
+
+def test_ablation_spans_sittings_by_keeping_finished_runs_beside_the_results(tmp_path):
+    """A fresh machine has no runs/: finished runs are reused from OUT/ablation_runs, new ones are
+    bounded per call (seed by seed), and a run kept with other settings is trained again."""
+    common = dict(minutes=1.0, steps=120, backend="inline")
+    first = run_ablation(tmp_path, seeds=[0, 1], runs_dir=tmp_path / "runs_a", max_new_runs=2, **common)
+    assert list(first["runs"]) == ["LBGP_s0", "LBGP-no-curriculum_s0"]  # every variant's seed 0 comes first
+    assert not first["complete"]
+    assert first["missing_runs"] == ["E2E_s0", "LBGP_s1", "LBGP-no-curriculum_s1", "E2E_s1"]
+    assert json.loads((tmp_path / "ablation.json").read_text())["missing_runs"] == first["missing_runs"]
+
+    shutil.rmtree(tmp_path / "runs_a")  # the next sitting starts without the training runs
+    second = run_ablation(tmp_path, seeds=[0, 1], runs_dir=tmp_path / "runs_b", max_new_runs=1, **common)
+    assert second["runs"]["LBGP_s0"] == first["runs"]["LBGP_s0"]  # reused, not retrained
+    assert not (tmp_path / "runs_b" / "LBGP_s0").exists() and (tmp_path / "runs_b" / "E2E_s0").is_dir()
+    assert second["missing_runs"] == ["LBGP_s1", "LBGP-no-curriculum_s1", "E2E_s1"]
+
+    other = run_ablation(tmp_path, seeds=[0], runs_dir=tmp_path / "runs_c", max_new_runs=1, minutes=1.0, steps=100, backend="inline")
+    assert (tmp_path / "runs_c" / "LBGP_s0").is_dir()  # another budget: the kept run does not count
+    assert json.loads((tmp_path / "ablation_runs" / "LBGP_s0" / "config.json").read_text())["total_steps"] == 100
+    assert other["missing_runs"] == ["LBGP-no-curriculum_s0", "E2E_s0"]
 
 
 def test_experiment_cli_checks_its_arguments(tmp_path):

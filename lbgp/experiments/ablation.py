@@ -5,12 +5,20 @@ seeds with a shaded 95 % confidence interval.
 
 The curves are the exploiting actor's returns. Note that with curriculum the early points are on
 easier levels (the paper plots it the same way). Runs live in ``runs/ablation`` by default (their
-checkpoints hold the replay, ~100 MB each) and resume where they stopped: an interrupted ablation,
-or one spread over several sessions, is continued by the same command.
+checkpoints hold the replay, ~100 MB each) and resume where they stopped.
+
+Nine 30-minute runs take 4.5 hours, more than one sitting on a fresh machine whose ``runs/`` is gone
+the next time. So every finished run's small files (config.json, curve.csv, summary.json) are kept
+beside the results, in ``ablation_runs/<run>/``, and a later call with the same settings reuses them
+instead of training again; ``max_new_runs`` bounds how many runs one call trains. Runs go seed by
+seed (every variant's seed 0 first), so a partial ablation already compares the variants. Until all
+runs are there, ``ablation.json`` says ``complete: false`` and lists the missing ones.
 """
 
 from __future__ import annotations
 
+import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +38,30 @@ VARIANTS = {
 
 
 DEFAULT_RUNS_DIR = Path("runs") / "ablation"
+ARCHIVE_NAME = "ablation_runs"  # under the results folder: the finished runs' small files
+ARCHIVED_FILES = ("config.json", "curve.csv", "summary.json")
+
+
+def archived_run(archive: Path, cfg: D4PGConfig) -> dict | None:
+    """The summary of a finished run kept in ``archive`` with exactly this configuration, else None
+    (missing files, or a run made with other settings or an older set of defaults)."""
+    try:
+        if not all((archive / name).is_file() for name in ARCHIVED_FILES):
+            return None
+        if json.loads((archive / "config.json").read_text()) != json.loads(cfg.to_json()):
+            return None
+        return json.loads((archive / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def archive_run(run: Path, archive: Path) -> None:
+    """Copy a finished run's small files into ``archive`` (summary.json last: it marks the copy whole)."""
+    archive.mkdir(parents=True, exist_ok=True)
+    (archive / "summary.json").unlink(missing_ok=True)
+    for name in ARCHIVED_FILES:
+        shutil.copyfile(run / name, archive / (name + ".tmp"))
+        (archive / (name + ".tmp")).replace(archive / name)
 
 
 def final_returns(summaries: dict, labels: dict) -> dict:
@@ -47,23 +79,35 @@ def final_returns(summaries: dict, labels: dict) -> dict:
 
 
 def run_ablation(out_dir="results", minutes: float = 30.0, seeds=(0, 1, 2), steps: int | None = None, backend: str = "processes",
-                 runs_dir=None, command: str = "") -> dict:
-    """Train every variant for every seed (``minutes`` wall time each, and at most ``steps``);
-    writes ``ablation_curves.png`` and ``ablation.json`` (the runs' summaries and each variant's
-    final return over the seeds) in ``out_dir``."""
+                 runs_dir=None, command: str = "", max_new_runs: int | None = None) -> dict:
+    """Train every variant for every seed (``minutes`` wall time each, and at most ``steps``),
+    reusing finished runs kept in ``out_dir/ablation_runs`` and training at most ``max_new_runs``
+    new ones; writes ``ablation_curves.png`` and ``ablation.json`` (the runs' summaries, each
+    variant's final return over the seeds, and which runs are still missing) in ``out_dir``."""
     out_dir = Path(out_dir)
     runs_dir = Path(runs_dir) if runs_dir else DEFAULT_RUNS_DIR
-    dirs, labels, summaries, run_labels = [], [], {}, {}
-    for label, variant in VARIANTS.items():
-        for seed in seeds:
-            run = runs_dir / f"{label}_s{seed}"
+    dirs, labels, summaries, run_labels, missing, trained = [], [], {}, {}, [], 0
+    for seed in seeds:
+        for label, variant in VARIANTS.items():
+            name = f"{label}_s{seed}"
+            run, archive = runs_dir / name, out_dir / ARCHIVE_NAME / name
             cfg = D4PGConfig(seed=seed, total_steps=steps or D4PGConfig.total_steps, time_limit_s=minutes * 60.0, **variant)
-            summaries[run.name] = train(cfg, run, resume=(run / "checkpoint.pt").exists(), backend=backend, progress=False)
-            dirs.append(run)
+            summary = archived_run(archive, cfg)
+            if summary is None:
+                if max_new_runs is not None and trained >= max_new_runs:
+                    missing.append(name)
+                    continue
+                summary = train(cfg, run, resume=(run / "checkpoint.pt").exists(), backend=backend, progress=False)
+                archive_run(run, archive)
+                trained += 1
+            summaries[name] = summary
+            dirs.append(archive)
             labels.append(label)
-            run_labels[run.name] = label
-    plot_learning_curves(dirs, out_dir / "ablation_curves.png", labels=labels, x="wall_time", band="ci95")
+            run_labels[name] = label
+    if dirs:
+        plot_learning_curves(dirs, out_dir / "ablation_curves.png", labels=labels, x="wall_time", band="ci95")
     report = {"command": command or "lbgp experiment ablation", "minutes_per_run": minutes, "seeds": list(seeds),
+              "complete": not missing, "missing_runs": missing,
               "final_returns": final_returns(summaries, run_labels), "runs": summaries}
     write_json(out_dir / "ablation.json", report)
     return report

@@ -2,6 +2,7 @@
 
     python benchmarks/sim2real_gap.py --json results/sim2real_gap.json [--episodes 10] [--repeats 5]
         [--e2e-randomized runs/e2e_rand/policy.pt] [--lbgp-policy FILE] [--methods lbgp,hc,e2e,e2e_randomized] [--jobs 2]
+        [--update]
 
 Two parts, the same seeds for every method and both dynamics:
 * the paper's 9 simulation scenarios on the Jackal (``lbgp evaluate``'s episodes, observation noise on);
@@ -18,15 +19,23 @@ to the simulated robot's. The benchmark runs those two steps itself. Two more, `
 and ``hardware_like_online``, drive through the online calibration (``--calibration online``,
 ``lbgp.online_calibration``): no identification run; one estimator per robot and column, carried
 from run to run in the order below (the first episode starts from nothing), as one robot doing
-every run would keep what it learned. An E2E policy
+every run would keep what it learned. One more, ``hardware_like_model``, uses everything the same
+identification gives: the sysid calibration and the fitted dynamics as the planner's drive model
+(``--drive-model``, ``lbgp.drive_model``: plan within the identified acceleration limits from the
+state predicted one latency ahead). An E2E policy sends its own commands, so for E2E that column
+only repeats the calibrated one's conditions. An E2E policy
 trained with domain randomisation (``lbgp train --method e2e --randomize default``) is reported
 beside the shipped one when ``--e2e-randomized`` names it.
+
+``--update`` reruns only ``--methods`` and keeps the other methods' entries of the existing JSON
+(each entry names the command that made it).
 """
 
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import json
 import math
 import sys
 import tempfile
@@ -39,6 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
 
 from lbgp.calibration import CommandCalibration  # noqa: E402
+from lbgp.dynamics import Dynamics  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.online_calibration import OnlineCalibration  # noqa: E402
@@ -50,45 +60,53 @@ from lbgp.sim import scenario_names  # noqa: E402
 
 CALIBRATED = "hardware_like_calibrated"
 ONLINE = ("nominal_online", "hardware_like_online")
-COLUMNS = ("nominal", "hardware_like", CALIBRATED, *ONLINE)
+MODEL = "hardware_like_model"
+COLUMNS = ("nominal", "hardware_like", CALIBRATED, *ONLINE, MODEL)
 
 
-def identified_calibration(robot: str) -> tuple[CommandCalibration, dict]:
-    """Excite the hardware-like robot, identify it, calibrate against the simulated robot's gains."""
+def identified_calibration(robot: str) -> tuple[CommandCalibration, Dynamics, dict]:
+    """Excite the hardware-like robot, identify it, calibrate against the simulated robot's gains;
+    the calibration, the fitted dynamics (the drive model) and a summary."""
     with tempfile.TemporaryDirectory() as folder:
         log = Path(folder) / "excite.mcap"
         record_excitation(robot, log, dynamics="hardware_like", seed=1)
         fit = identify(log, robot)
     calibration = CommandCalibration.from_gains(robot, fit.gain_v, fit.gain_w, f"sysid of the hardware-like {robot}")
-    return calibration, {"gain_v": round(fit.gain_v, 4), "gain_w": round(fit.gain_w, 4),
-                         "scale_v": round(calibration.scale_v, 4), "scale_w": round(calibration.scale_w, 4)}
+    return calibration, fit.dynamics, {"gain_v": round(fit.gain_v, 4), "gain_w": round(fit.gain_w, 4),
+                                       "scale_v": round(calibration.scale_v, 4), "scale_w": round(calibration.scale_w, 4),
+                                       "drive_model": {k: v for k, v in fit.summary().items() if k not in ("gain_v", "gain_w")}}
 
 
-def runs_of(calibration: CommandCalibration, robot: str):
-    """(column, dynamics, calibration) for the five columns (a fresh online estimator for each)."""
-    return [("nominal", "nominal", None), ("hardware_like", "hardware_like", None), (CALIBRATED, "hardware_like", calibration),
-            ("nominal_online", "nominal", OnlineCalibration(robot)), ("hardware_like_online", "hardware_like", OnlineCalibration(robot))]
+def runs_of(identified: tuple, robot: str):
+    """(column, dynamics, calibration, drive model) for the six columns (a fresh online estimator for each)."""
+    calibration, drive_model = identified
+    return [("nominal", "nominal", None, None), ("hardware_like", "hardware_like", None, None),
+            (CALIBRATED, "hardware_like", calibration, None),
+            ("nominal_online", "nominal", OnlineCalibration(robot), None),
+            ("hardware_like_online", "hardware_like", OnlineCalibration(robot), None),
+            (MODEL, "hardware_like", calibration, drive_model)]
 
 
-def scenario_part(policy, method: str, episodes: int, seed: int, calibration: CommandCalibration) -> tuple[dict, dict]:
+def scenario_part(policy, method: str, episodes: int, seed: int, identified: tuple) -> tuple[dict, dict]:
     """Per column: each scenario's mean reward, and the half-width of its 95 % interval."""
     means, half_widths = {}, {}
-    for column, dynamics, cal in runs_of(calibration, "jackal"):
+    for column, dynamics, cal, model in runs_of(identified, "jackal"):
         rows = evaluate(policy, method, scenario_names(), robot="jackal", episodes=episodes, seed=seed, obs_noise=True,
-                        dynamics=dynamics, calibration=cal)
+                        dynamics=dynamics, calibration=cal, drive_model=model)
         means[column] = {r["scenario"]: round(r["reward"], 3) for r in rows}
         half_widths[column] = {r["scenario"]: round(r["reward_ci95"], 3) for r in rows}
     return means, half_widths
 
 
-def protocol_part(policy, repeats: int, steps: int, seed: int, calibration: CommandCalibration) -> tuple[dict, dict]:
+def protocol_part(policy, repeats: int, steps: int, seed: int, identified: tuple) -> tuple[dict, dict]:
     """Per column: each setting's mean reward over ``repeats`` runs, and its 95 % half-width."""
     means, half_widths = {}, {}
-    for column, dynamics, cal in runs_of(calibration, "turtlebot2"):
+    for column, dynamics, cal, model in runs_of(identified, "turtlebot2"):
         means[column], half_widths[column] = {}, {}
         for path in PATHS:
             for setting in SETTINGS[path]:
-                runs = [run_setting(policy, path, setting, steps, seed + r, dynamics=dynamics, calibration=cal) for r in range(repeats)]
+                runs = [run_setting(policy, path, setting, steps, seed + r, dynamics=dynamics, calibration=cal, drive_model=model)
+                        for r in range(repeats)]
                 rewards = [m.total_reward for m in runs]
                 means[column][f"{path}/{setting}"] = round(float(np.mean(rewards)), 3)
                 half_widths[column][f"{path}/{setting}"] = round(reward_ci95(rewards), 3)
@@ -99,13 +117,13 @@ def totals(part: dict, half_widths: dict) -> dict:
     """Each column's sum with the half-width of its 95 % interval (the rows' combined in quadrature),
     and the share of the nominal robot's kept on the hardware-like one: ``kept`` (no calibration),
     ``kept_calibrated`` (sysid's), ``kept_online`` (online, against the nominal robot driven through
-    the online calibration too), each with a 95 % half-width (``*_ci95``: the two sums' relative
+    the online calibration too), ``kept_model`` (sysid's calibration and drive model), each with a 95 % half-width (``*_ci95``: the two sums' relative
     half-widths in quadrature; conservative, as both columns run the same seeds)."""
     sums = {c: sum(part[c].values()) for c in COLUMNS}
     hw = {c: math.sqrt(sum(h**2 for h in half_widths[c].values())) for c in COLUMNS}
     out = {**{c: round(v, 2) for c, v in sums.items()}, "ci95": {c: round(h, 2) for c, h in hw.items()}}
     for name, a, b in (("kept", "hardware_like", "nominal"), ("kept_calibrated", CALIBRATED, "nominal"),
-                       ("kept_online", "hardware_like_online", "nominal_online")):
+                       ("kept_online", "hardware_like_online", "nominal_online"), ("kept_model", MODEL, "nominal")):
         if sums[b] > 0 and sums[a] != 0:
             ratio = sums[a] / sums[b]
             out[name] = round(ratio, 3)
@@ -117,15 +135,22 @@ def totals(part: dict, half_widths: dict) -> dict:
 
 def method_result(job) -> tuple[str, dict]:
     """Both parts for one method (a process of its own with ``--jobs``)."""
-    name, path, args, calibrations = job
+    name, path, args, identified = job
     method = "e2e" if name.startswith("e2e") else name
-    scen, scen_hw = scenario_part(make_policy(method, path, robot="jackal"), method, args.episodes, args.seed, calibrations["jackal"])
+    scen, scen_hw = scenario_part(make_policy(method, path, robot="jackal"), method, args.episodes, args.seed, identified["jackal"])
     proto, proto_hw = protocol_part(make_policy(method, path, robot="turtlebot2", transfer=True), args.repeats, args.steps,
-                                    args.seed, calibrations["turtlebot2"])
+                                    args.seed, identified["turtlebot2"])
     scen_totals, proto_totals = totals(scen, scen_hw), totals(proto, proto_hw)
     print(f"{name}: scenarios {scen_totals}, protocol {proto_totals}", file=sys.stderr, flush=True)
-    return name, {"scenarios": {**scen_totals, "per_scenario": scen, "per_scenario_ci95": scen_hw},
+    return name, {"command": args.command, "scenarios": {**scen_totals, "per_scenario": scen, "per_scenario_ci95": scen_hw},
                   "real_protocol": {**proto_totals, "per_setting": proto, "per_setting_ci95": proto_hw}}
+
+
+def carried_over(earlier: dict, rerun) -> dict:
+    """``--update``: the methods of an earlier result not in ``rerun``, each naming the command that
+    made it (an entry without one was made by the earlier file's command)."""
+    return {name: {**entry, "command": entry.get("command", earlier.get("command"))}
+            for name, entry in earlier.get("methods", {}).items() if name not in rerun}
 
 
 def main() -> None:
@@ -140,7 +165,9 @@ def main() -> None:
     ap.add_argument("--lbgp-policy", help="LBGP policy file (default: the shipped one)")
     ap.add_argument("--methods", default="lbgp,hc,e2e,e2e_randomized",
                     help="comma-separated subset of lbgp,hc,e2e,e2e_randomized (default: all; e2e_randomized needs --e2e-randomized)")
+    ap.add_argument("--update", action="store_true", help="keep the other methods' entries of the existing --json file")
     args = ap.parse_args()
+    args.command = "python benchmarks/sim2real_gap.py " + " ".join(sys.argv[1:])
 
     wanted = [m.strip() for m in args.methods.split(",") if m.strip()]
     unknown = set(wanted) - {"lbgp", "hc", "e2e", "e2e_randomized"}
@@ -150,15 +177,17 @@ def main() -> None:
     if args.e2e_randomized:
         methods["e2e_randomized"] = args.e2e_randomized
     methods = {name: path for name, path in methods.items() if name in wanted}
-    result = {"command": "python benchmarks/sim2real_gap.py " + " ".join(sys.argv[1:]), "episodes": args.episodes,
-              "repeats": args.repeats, "methods": {}}
+    result = {"command": args.command, "episodes": args.episodes, "repeats": args.repeats, "methods": {}}
+    if args.update and Path(args.json).is_file():
+        result["methods"].update(carried_over(json.loads(Path(args.json).read_text()), methods))
     t0 = time.perf_counter()
-    calibrations, identified = {}, {}
+    identified, summaries = {}, {}
     for robot in ("jackal", "turtlebot2"):
-        calibrations[robot], identified[robot] = identified_calibration(robot)
-    result["calibration"] = identified
-    print(f"calibration: {identified}", file=sys.stderr, flush=True)
-    jobs = [(name, path, args, calibrations) for name, path in methods.items()]
+        calibration, drive_model, summaries[robot] = identified_calibration(robot)
+        identified[robot] = (calibration, drive_model)
+    result["calibration"] = summaries
+    print(f"calibration: {summaries}", file=sys.stderr, flush=True)
+    jobs = [(name, path, args, identified) for name, path in methods.items()]
     if args.jobs > 1:
         with concurrent.futures.ProcessPoolExecutor(min(args.jobs, len(jobs))) as pool:
             done = list(pool.map(method_result, jobs))
@@ -167,7 +196,7 @@ def main() -> None:
     for name, entry in done:
         result["methods"][name] = entry
     result["wall_time_s"] = round(time.perf_counter() - t0, 1)
-    if not args.e2e_randomized and "e2e_randomized" in wanted:
+    if not args.e2e_randomized and "e2e_randomized" in wanted and "e2e_randomized" not in result["methods"]:
         result["e2e_randomized"] = "not run: no randomised E2E policy given (--e2e-randomized)"
     write_result(args.json, result)
 

@@ -71,7 +71,7 @@ def cmd_evaluate(args) -> int:
     try:
         results = evaluate(policy, args.method, names, robot=args.robot, episodes=args.episodes, seed=args.seed,
                            recorder=recorder, person_path=args.person_path, dynamics=args.dynamics,
-                           calibration=args.calibration)
+                           calibration=args.calibration, drive_model=args.drive_model)
     finally:
         if recorder is not None:
             recorder.close()
@@ -150,7 +150,7 @@ def cmd_deploy(args) -> int:
                       planner_time_budget=args.planner_budget_ms / 1e3 if args.planner_budget_ms > 0 else None,
                       metadata={"method": args.method, "policy": args.policy or "default"},
                       first_pose_timeout=args.first_pose_timeout or None, dynamics=args.dynamics, calibration=args.calibration,
-                      on_open=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True),
+                      drive_model=args.drive_model, on_open=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True),
                       on_wait=lambda msg: print(f"lbgp deploy: {msg}", file=sys.stderr, flush=True))
     except KeyboardInterrupt:  # before the loop ran (opening the source, the log, the viewer)
         print("interrupted before the loop started: no command was sent", file=sys.stderr)
@@ -235,6 +235,10 @@ def cmd_experiment(args) -> int:
         if report["runs"]:
             print(f"wrote {Path(args.out, 'ablation_curves.png')}")
     return 0
+
+
+DRIVE_MODEL_HELP = ("the planner's model of the robot's drive: none (default: it acts at once), hardware_like, or lbgp sysid's "
+                    "JSON; goal methods (lbgp, hc) then plan within its acceleration limits from the state predicted one latency ahead")
 
 
 def _names(text: str) -> list[str]:
@@ -330,6 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--calibration", type=A.calibration_spec, default=None,
                    help="command calibration: none (default), online (the robot's gains estimated while driving) or lbgp sysid's JSON "
                         "(commands scaled so the robot answers like the simulated one)")
+    p.add_argument("--drive-model", type=A.drive_model_spec, default=None, help=DRIVE_MODEL_HELP)
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
@@ -414,6 +419,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--calibration", type=A.calibration_spec, default=None,
                    help="command calibration: none (default), online (the robot's gains estimated while driving) or lbgp sysid's JSON "
                         "for this robot (every command sent is scaled by it)")
+    p.add_argument("--drive-model", type=A.drive_model_spec, default=None, help=DRIVE_MODEL_HELP)
     p.set_defaults(func=cmd_deploy)
 
     p = sub.add_parser("sysid", help="identify a robot's dynamics from a deploy log (or --excite: record one)")

@@ -83,6 +83,12 @@ def dynamics_spec(text: str) -> str:
         raise argparse.ArgumentTypeError(f"{exc}; use nominal, hardware_like or a JSON file of dynamics parameters") from None
 
 
+def drive_model_spec(text: str) -> str:
+    """``none``, a named dynamics set (nominal, hardware_like) or an existing JSON file of dynamics
+    (``lbgp sysid``'s output): the planner's model of the robot's drive."""
+    return "none" if text == "none" else dynamics_spec(text)
+
+
 def calibration_spec(text: str) -> str:
     """``none``, ``online`` (gains estimated while driving) or an existing JSON file (``lbgp sysid``'s
     output, or scale_v / scale_w)."""

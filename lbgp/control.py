@@ -59,12 +59,15 @@ class GoalController:
 
     kind = "goal"
 
-    def __init__(self, planner: TebPlanner):
+    def __init__(self, planner: TebPlanner, prediction=None):
         self.planner = planner
+        self.prediction = prediction  # lbgp.drive_model.DrivePrediction: plan from the state when the command acts
         self.goal_person = np.array(DESIRED_GOAL)
 
     def reset(self) -> None:
         self.planner.reset()
+        if self.prediction is not None:
+            self.prediction.reset()
         self.goal_person = np.array(DESIRED_GOAL)
 
     def set_action(self, action, state: WorldState) -> None:
@@ -75,9 +78,12 @@ class GoalController:
         self.goal_person = np.asarray(goal_person_xy, dtype=float).reshape(2)
 
     def command(self, state: WorldState) -> Command:
-        goal = from_frame(np.array([self.goal_person[0], self.goal_person[1], 0.0]), state.person_pose)
+        seen = state if self.prediction is None else self.prediction.predict(state)
+        goal = from_frame(np.array([self.goal_person[0], self.goal_person[1], 0.0]), seen.person_pose)
         plan = self.planner.plan(
-            state.robot_pose, state.robot_velocity, goal, state.person_pose, state.person_velocity,
-            person_turn_rate=state.person_turn_rate, goal_moves_with_person=True,
+            seen.robot_pose, seen.robot_velocity, goal, seen.person_pose, seen.person_velocity,
+            person_turn_rate=seen.person_turn_rate, goal_moves_with_person=True,
         )
+        if self.prediction is not None:
+            self.prediction.sent(state.t, plan.v, plan.w)
         return Command(plan.v, plan.w, plan.status, goal, plan)

@@ -1,7 +1,7 @@
 """How a robot's base responds to a velocity command: the named parameters the simulator applies and
 system identification fits (one place, beside ``lbgp.robots.RobotSpec``).
 
-The chain from a (v, w) command to the wheels, as simulated (``lbgp.sim.drive``):
+The chain from a (v, w) command to the wheels, as simulated (``lbgp.drive_train``, ``lbgp.sim.drive``):
 
     command --[latency]--> base firmware --[acceleration limiter]--> wheel setpoints
             --[first-order lag, time constant]--> MuJoCo velocity servos (gain, torque limit)

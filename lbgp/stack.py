@@ -8,6 +8,8 @@ from __future__ import annotations
 import dataclasses
 
 from lbgp.control import GoalController, VelocityController
+from lbgp.drive_model import DrivePrediction, within_drive_limits
+from lbgp.dynamics import Dynamics
 from lbgp.conventions import PLANNER_PERIOD
 from lbgp.planner import PlannerConfig, TebPlanner, planner_config_for
 from lbgp.robots import RobotSpec, get_robot
@@ -27,11 +29,15 @@ def planner_limits(robot: str | RobotSpec, planner_period: float = PLANNER_PERIO
     return dataclasses.replace(base, control_period=float(planner_period), sqp_time_budget=budget)
 
 
-def make_controller(control: str, limits: PlannerConfig):
+def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None):
     """``goal``: the policy's goal goes through the planner (LBGP, HC); ``velocity``: the policy's
-    (v, w) is clamped to the limits (E2E)."""
+    (v, w) is clamped to the limits (E2E). ``drive_model`` (``lbgp.drive_model``): the planner keeps
+    within the drive's acceleration limits and plans from the state predicted one latency ahead;
+    a velocity policy's commands are its own and pass unchanged."""
     if control == "goal":
-        return GoalController(TebPlanner(limits))
+        if drive_model is None:
+            return GoalController(TebPlanner(limits))
+        return GoalController(TebPlanner(within_drive_limits(limits, drive_model)), prediction=DrivePrediction(drive_model))
     if control == "velocity":
         return VelocityController(limits)
     raise ValueError(f"unknown control mode {control!r}; use 'goal' or 'velocity'")

@@ -1,4 +1,4 @@
-"""Robot dynamics (lbgp.dynamics, lbgp.sim.drive): named parameters applied to the MuJoCo model and
+"""Robot dynamics (lbgp.dynamics, lbgp.drive_train, lbgp.sim.drive): named parameters applied to the MuJoCo model and
 the drive train, domain randomisation, and the simulator's default staying what it was."""
 
 import json
@@ -9,7 +9,7 @@ import pytest
 
 from lbgp.dynamics import HARDWARE_LIKE, Dynamics, Randomization, load_dynamics, load_randomization
 from lbgp.sim import make_env
-from lbgp.sim.drive import DriveTrain, simulate_setpoints
+from lbgp.drive_train import DriveTrain, simulate_setpoints
 
 
 def test_drive_train_delays_limits_and_lags_a_step_command():

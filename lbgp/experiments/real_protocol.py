@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from lbgp.calibration import load_calibration
+from lbgp.drive_model import load_drive_model
 from lbgp.experiments import paper
 from lbgp.experiments.tables import write_tables
 from lbgp.metrics import aggregate
@@ -63,13 +64,15 @@ DYNAMICS_SETS = ("nominal", "hardware_like")  # lbgp.dynamics: the trained-on mo
 
 
 def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None,
-                calibration=None):
+                calibration=None, drive_model=None):
     """One run of the protocol through the deployment loop; returns its EpisodeMetrics.
-    ``calibration``: the command calibration (``lbgp.calibration``) of the deploy loop."""
+    ``calibration``: the command calibration (``lbgp.calibration``) of the deploy loop;
+    ``drive_model``: its planner's model of the drive (``lbgp.drive_model``)."""
     world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting], dynamics=dynamics)
     source = SimPoseSource(world, disturbance if disturbance is not None else MocapDisturbance(), seed=seed)
     config = DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE,
-                          calibration=load_calibration(calibration, "turtlebot2"))
+                          calibration=load_calibration(calibration, "turtlebot2"),
+                          drive_model=load_drive_model(drive_model, "turtlebot2"))
     loop = DeployLoop(source, SimCommandSink(world), policy, config,
                       recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=False,
                       name=f"{path}/{setting}")

@@ -30,6 +30,7 @@ import numpy as np
 
 from lbgp import stack
 from lbgp.calibration import CommandCalibration
+from lbgp.dynamics import Dynamics
 from lbgp.online_calibration import OnlineCalibration
 from lbgp.conventions import PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha
@@ -81,6 +82,7 @@ class DeployConfig:
     safety: SafetyConfig = dataclasses.field(default_factory=SafetyConfig)
     # applied to every command sent: fixed (lbgp sysid's gains) or estimated while driving (OnlineCalibration)
     calibration: CommandCalibration | OnlineCalibration = dataclasses.field(default_factory=CommandCalibration)
+    drive_model: Dynamics | None = None  # the planner's model of the drive (lbgp.drive_model); None: the ideal drive
 
 
 @dataclasses.dataclass
@@ -113,7 +115,7 @@ class DeployLoop:
         self.logger, self.recorder = logger, recorder
         self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
         self.limits = stack.planner_limits(self.cfg.robot, self.cfg.planner_period, time_budget=self.cfg.planner_time_budget)
-        self.controller = stack.make_controller(policy.control, self.limits)
+        self.controller = stack.make_controller(policy.control, self.limits, self.cfg.drive_model)
         self.cfg.calibration.reset()  # an online calibration starts each run afresh
         self.monitor = SafetyMonitor(self.cfg.safety)
         self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance

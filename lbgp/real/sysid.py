@@ -4,7 +4,7 @@ limits, gains) from a deploy log's commands and motion-capture poses.
     lbgp sysid --excite --robot turtlebot2 --log excite.mcap     # record (sim, or your robot via udp://)
     lbgp sysid excite.mcap --robot turtlebot2 --out dynamics.json [--png fit.png]
 
-The model is the simulator's own drive train (``lbgp.sim.drive.DriveTrain``: command latency, the
+The model is the simulator's own drive train (``lbgp.drive_train.DriveTrain``: command latency, the
 firmware's acceleration limiter, a first-order lag) followed by gains on v and w (what the wheels
 and the floor make of the setpoint: servo gain, skid-steer slip). The measured body velocity comes
 from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative). The
@@ -22,7 +22,7 @@ import numpy as np
 
 from lbgp.actions import MAX_V, MAX_W
 from lbgp.dynamics import Dynamics, nominal
-from lbgp.sim.drive import simulate_setpoints
+from lbgp.drive_train import simulate_setpoints
 
 MIN_DURATION = 5.0  # s of overlapping commands and poses a fit needs
 MIN_POSES = 40

@@ -130,6 +130,7 @@ def make_env(
     dynamics=None,
     randomize=None,
     calibration=None,
+    drive_model=None,
 ) -> FollowAheadEnv:
     """A follow-ahead environment.
 
@@ -152,6 +153,8 @@ def make_env(
         (``lbgp.dynamics.RANDOMIZATION``), a JSON file of ranges or a ``Randomization``; off by default.
       calibration: the command calibration (``lbgp.calibration``) applied where commands reach the
         wheels: ``None`` (the identity), a ``CommandCalibration`` or a JSON file (``lbgp sysid``'s output).
+      drive_model: the planner's model of the robot's drive (``lbgp.drive_model``): ``None`` (the
+        ideal drive it assumes by default), a ``Dynamics``, a named set or ``lbgp sysid``'s JSON.
     """
     setting = tasks.get_setting(level)
     if person_path is not None:
@@ -162,7 +165,7 @@ def make_env(
     task = tasks.FollowAheadTask(
         spec, setting, control_mode=control, obs_noise=obs_noise, planner_config=planner_config,
         random=np.random.default_rng(seed), planner_period=planner_period, spawn_front_share=spawn_front_share,
-        dynamics=dynamics, randomize=randomize, calibration=calibration,
+        dynamics=dynamics, randomize=randomize, calibration=calibration, drive_model=drive_model,
     )
     return FollowAheadEnv(physics, task, horizon=horizon, planner_period=planner_period)
 

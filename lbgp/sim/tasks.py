@@ -20,12 +20,14 @@ from dm_env import specs
 
 from lbgp import stack
 from lbgp.calibration import load_calibration
+from lbgp.drive_model import load_drive_model
 from lbgp.control import Command
 from lbgp.conventions import AGENT_PERIOD, DESIRED_DISTANCE, PLANNER_PERIOD
 from lbgp.geometry import distance_and_alpha, integrate_unicycle, pose_from_polar, yaw_from_quaternion
 from lbgp.dynamics import Dynamics, Randomization, load_dynamics, load_randomization
 from lbgp.sim import observation as obs_lib
-from lbgp.sim.drive import DriveTrain, ModelDynamics
+from lbgp.drive_train import DriveTrain
+from lbgp.sim.drive import ModelDynamics
 from lbgp.sim import paths as path_lib
 from lbgp.sim.person import CircleMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
 from lbgp.sim.rewards import follow_ahead_reward, out_of_range
@@ -269,6 +271,7 @@ class FollowAheadTask(control.Task):
         dynamics: Dynamics | str | None = None,
         randomize: Randomization | str | dict | None = None,
         calibration=None,
+        drive_model=None,
     ):
         self.spec = spec
         # what leaves the controller is scaled to what this robot must be told (lbgp.calibration)
@@ -285,7 +288,9 @@ class FollowAheadTask(control.Task):
         self.setting = setting
         self.motion = setting.motion()
         self.limits = stack.planner_limits(spec, planner_period, planner_config)
-        self.controller = stack.make_controller(control_mode, self.limits)
+        # the planner's model of the drive (lbgp.drive_model): None, it assumes the ideal drive
+        self.drive_model = load_drive_model(drive_model, spec.name)
+        self.controller = stack.make_controller(control_mode, self.limits, self.drive_model)
         self.control_mode = control_mode
         noise_on = setting.noise if obs_noise is None else obs_noise
         self.stack = obs_lib.ObservationStack(noise_std=noise_std if noise_on else None)
@@ -360,7 +365,8 @@ class FollowAheadTask(control.Task):
         # velocity (a skid-steer base overshoots its yaw rate at speed; chaining from that
         # measurement forced ever harder turns)
         commanded = np.array([self.last_command.v, self.last_command.w])
-        return WorldState(self.time, physics.robot_pose(), commanded, self.person_pose.copy(), person_velocity, turn_rate)
+        # the physics clock (restarted each episode): the planner ticks twice per agent step
+        return WorldState(float(physics.data.time), physics.robot_pose(), commanded, self.person_pose.copy(), person_velocity, turn_rate)
 
     # -- stepping (called by lbgp.sim.env.FollowAheadEnv)
     def before_step(self, action, physics: Physics) -> None:

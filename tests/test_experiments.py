@@ -95,6 +95,16 @@ def test_ablation_on_a_tiny_budget(tmp_path):
     assert sorted(p.name for p in kept.iterdir()) == ["config.json", "curve.csv", "summary.json"]
 
 
+def test_ablation_gives_every_variant_the_same_wall_time_and_e2e_steps_it_cannot_use_up():
+    from lbgp.experiments.ablation import variant_config
+
+    lbgp, e2e = variant_config("LBGP", 1, 30.0), variant_config("E2E", 1, 30.0)
+    assert lbgp.time_limit_s == e2e.time_limit_s == 1800.0 and lbgp.seed == e2e.seed == 1
+    assert lbgp.total_steps == 300_000 and e2e.total_steps == 1_000_000 and e2e.method == "e2e"
+    assert variant_config("LBGP-no-curriculum", 0, 30.0).curriculum is False
+    assert variant_config("E2E", 0, 1.0, steps=150).total_steps == 150
+
+
 def test_ablation_spans_sittings_by_keeping_finished_runs_beside_the_results(tmp_path):
     """A fresh machine has no runs/: finished runs are reused from OUT/ablation_runs, new ones are
     bounded per call (seed by seed), and a run kept with other settings is trained again."""

@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from lbgp.dynamics import Dynamics, load_dynamics
+from lbgp.geometry import predict_person
 from lbgp.drive_train import DriveTrain
 from lbgp.world import WorldState
 
@@ -75,15 +76,14 @@ class DrivePrediction:
             x += v * math.cos(yaw + 0.5 * w * dt) * dt
             y += v * math.sin(yaw + 0.5 * w * dt) * dt
             yaw += w * dt
-        turn = float(state.person_turn_rate)
-        angle = turn * self.horizon
-        c, s = math.cos(angle), math.sin(angle)
-        vx, vy = (float(u) for u in state.person_velocity)
-        # the person's arc: the mean of the velocity over the horizon is the velocity rotated half-way
-        ch, sh = math.cos(0.5 * angle), math.sin(0.5 * angle)
-        shift = np.array([ch * vx - sh * vy, sh * vx + ch * vy]) * self.horizon
+        # the person on the planner's constant-turn arc (velocity vector rotating at the turn rate)
+        velocity = np.asarray(state.person_velocity, dtype=float)
         person = np.asarray(state.person_pose, dtype=float).copy()
-        person[:2] += shift
+        path, rotation = predict_person(person[:2], velocity, float(state.person_turn_rate), np.array([self.horizon]))
+        angle = float(rotation[0])
+        c, s = math.cos(angle), math.sin(angle)
+        vx, vy = velocity
+        person[:2] = path[0]
         person[2] = math.remainder(person[2] + angle, 2 * math.pi)
         return dataclasses.replace(
             state, t=state.t + self.horizon, robot_pose=np.array([x, y, math.remainder(yaw, 2 * math.pi)]),
@@ -93,7 +93,7 @@ class DrivePrediction:
 def load_drive_model(spec, robot: str) -> Dynamics | None:
     """``None``/``"none"`` (the planner's own assumptions), a ``Dynamics``, a named set (nominal,
     hardware_like) or a JSON file of dynamics (``lbgp sysid``'s output)."""
-    if spec is None or (isinstance(spec, str) and spec == "none"):
+    if spec is None or spec == "none":
         return None
     return load_dynamics(spec, robot)
 

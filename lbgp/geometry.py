@@ -88,6 +88,20 @@ def integrate_unicycle(pose, v: float, w: float, dt) -> np.ndarray:
     return out
 
 
+def predict_person(xy, velocity, turn_rate: float, times: np.ndarray):
+    """The person's positions at ``times`` on a constant-turn arc (velocity vector rotating at
+    ``turn_rate``), and how far the person has turned by then (rad)."""
+    rotation = turn_rate * times
+    if abs(turn_rate) < 1e-6:
+        return xy[None, :] + times[:, None] * velocity[None, :], rotation
+    # integral of R(w s) v ds = (1/w) [[sin wt, cos wt - 1], [1 - cos wt, sin wt]] v
+    s_, c1 = np.sin(rotation), np.cos(rotation) - 1.0
+    vx, vy = velocity
+    dx = (s_ * vx + c1 * vy) / turn_rate
+    dy = (-c1 * vx + s_ * vy) / turn_rate
+    return xy[None, :] + np.stack([dx, dy], axis=1), rotation
+
+
 def finite_pose(pose) -> bool:
     """True when every component of the pose is a finite number."""
     return bool(np.all(np.isfinite(np.asarray(pose, dtype=float))))

@@ -18,12 +18,11 @@ runs are there, ``ablation.json`` says ``complete: false`` and lists the missing
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
 
-from lbgp.files import write_json
+from lbgp.files import write_json, write_text
 from lbgp.metrics import reward_ci95
 
 from lbgp.agent.config import D4PGConfig
@@ -58,12 +57,11 @@ def archived_run(archive: Path, cfg: D4PGConfig) -> dict | None:
 
 
 def archive_run(run: Path, archive: Path) -> None:
-    """Copy a finished run's small files into ``archive`` (summary.json last: it marks the copy whole)."""
-    archive.mkdir(parents=True, exist_ok=True)
+    """Copy a finished run's small files into ``archive``, each atomically (summary.json last: it
+    marks the copy whole)."""
     (archive / "summary.json").unlink(missing_ok=True)
     for name in ARCHIVED_FILES:
-        shutil.copyfile(run / name, archive / (name + ".tmp"))
-        (archive / (name + ".tmp")).replace(archive / name)
+        write_text(archive / name, (run / name).read_text())
 
 
 def final_returns(summaries: dict, labels: dict) -> dict:

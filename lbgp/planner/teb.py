@@ -47,7 +47,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from lbgp.geometry import wrap_angle
+from lbgp.geometry import predict_person, wrap_angle
 from lbgp.planner.config import PlannerConfig
 from lbgp.planner.kinematics import pursuit_commands, rollout
 from lbgp.planner.qp import PRIMAL_INFEASIBLE, SOLVED, SparseQP
@@ -98,20 +98,6 @@ def safe_stop(v_now: float, w_now: float, cfg: PlannerConfig) -> tuple[float, fl
     v = math.copysign(max(abs(v_now) - cfg.acc_lim_x * cfg.control_period, 0.0), v_now)
     w = math.copysign(max(abs(w_now) - cfg.acc_lim_theta * cfg.control_period, 0.0), w_now)
     return clamp_command(v, w, v_now, w_now, cfg)
-
-
-def predict_person(xy, velocity, turn_rate: float, times: np.ndarray):
-    """The person's positions at ``times`` on a constant-turn arc (velocity vector rotating at
-    ``turn_rate``), and how far the person has turned by then (rad)."""
-    rotation = turn_rate * times
-    if abs(turn_rate) < 1e-6:
-        return xy[None, :] + times[:, None] * velocity[None, :], rotation
-    # integral of R(w s) v ds = (1/w) [[sin wt, cos wt - 1], [1 - cos wt, sin wt]] v
-    s_, c1 = np.sin(rotation), np.cos(rotation) - 1.0
-    vx, vy = velocity
-    dx = (s_ * vx + c1 * vy) / turn_rate
-    dy = (-c1 * vx + s_ * vy) / turn_rate
-    return xy[None, :] + np.stack([dx, dy], axis=1), rotation
 
 
 @dataclasses.dataclass

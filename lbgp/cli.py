@@ -219,7 +219,7 @@ def cmd_experiment(args) -> int:
         if args.robot != "turtlebot2":
             raise ValueError("the real-world protocol uses the TurtleBot 2 (the paper's robot): --robot turtlebot2")
         run_real_protocol(args.out, steps=args.steps, seed=args.seed, paths=args.paths, policies=policies, repeats=args.repeats,
-                          command=command, dynamics_sets=args.dynamics)
+                          command=command, dynamics_sets=args.dynamics, jobs=args.jobs)
         tables = {"nominal": "real_protocol_table.md", "hardware_like": "real_protocol_hardware_table.md"}
         written = [tables[d] for d in args.dynamics] + (["real_protocol_gap.md"] if len(set(args.dynamics)) == 2 else [])
         for name in written:
@@ -384,6 +384,8 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--paths", type=_names, help="comma-separated subset of straight,s_shape,u_turn")
             q.add_argument("--dynamics", type=_names, default=["nominal", "hardware_like"],
                            help="comma-separated dynamics sets: nominal (trained on), hardware_like (the held-out robot); default both")
+            q.add_argument("--jobs", type=A.positive_int, default=1,
+                           help="processes, one per (dynamics set, method) at a time (default 1; the same numbers with any count)")
         if name == "ablation":
             q.add_argument("--minutes", type=A.positive_float, default=30.0, help="wall-time budget per training run (default 30)")
             q.add_argument("--seeds", type=_seed_list, default=[0, 1, 2], help="comma-separated seeds (default 0,1,2)")

@@ -56,6 +56,14 @@ def test_real_protocol_settings_start_where_the_paper_says():
     assert u[-1][0] < 0.1 and u[-1][1] == pytest.approx(-2.0)  # back where it came from, 2 m to the right
 
 
+def test_real_protocol_in_parallel_processes_gives_the_same_rows(tmp_path):
+    kwargs = dict(steps=3, paths=["straight"], methods=("hc", "lbgp"), dynamics_sets=("nominal",), repeats=2)
+    serial = run_real_protocol(tmp_path / "serial", **kwargs)
+    parallel = run_real_protocol(tmp_path / "parallel", jobs=2, **kwargs)
+    assert len(serial) == 8 and serial == parallel
+    assert (tmp_path / "parallel" / "real_protocol_table.md").read_text() == (tmp_path / "serial" / "real_protocol_table.md").read_text()
+
+
 def test_real_protocol_runs_through_the_deploy_loop_and_ends_far_runs(tmp_path):
     # a robot that drives away: the paper's rule ends the run once D > 3 m
     class Away:

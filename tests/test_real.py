@@ -234,6 +234,27 @@ def test_commands_stay_within_the_robots_limits(faulty_run):
     assert loop.monitor.counts[safety.NON_FINITE] == 5 and loop.monitor.counts[safety.JUMP] == 5
 
 
+def test_the_too_close_stop_stays_out_of_the_planners_way_while_it_passes_a_turning_person():
+    """The protocol's U-turn with the robot starting ahead-left: the planner passes the turning
+    person at its safety distance. A too_close stop at that distance halted the robot in the
+    person's path and the person walked into it (this run, and 19 of 20 HC runs); the default stop
+    distance lies inside the planner's band, so it never fires here, and still outside contact."""
+    from lbgp.experiments.real_protocol import PATHS, SETTINGS
+    from lbgp.policies import make_policy
+    from lbgp.real.sim_world import MocapDisturbance, SimCommandSink, SimPoseSource, SimWorld
+
+    world = SimWorld(robot="turtlebot2", seed=1, person_path=PATHS["u_turn"](), spawn=SETTINGS["u_turn"]["ahead_left"])
+    loop = DeployLoop(SimPoseSource(world, MocapDisturbance(), seed=1), SimCommandSink(world), make_policy("hc", robot="turtlebot2"),
+                      DeployConfig(robot="turtlebot2", max_steps=60, end_distance=3.0),
+                      end_condition=lambda: "contact" if world.contact else None)
+    metrics = loop.run()
+    limits = loop.limits
+    assert limits.footprint_radius + limits.person_radius < loop.min_distance < limits.safety_distance - limits.clearance_tolerance
+    assert not metrics.contact and metrics.steps == 60
+    assert all(r.status != safety.TOO_CLOSE for r in loop.records)
+    assert min(metrics.distances) < limits.safety_distance + 0.05  # it did pass close: the case this is about
+
+
 def test_robot_stops_when_too_close_to_the_person_whatever_the_policy():
     class Pushy:
         control = "velocity"

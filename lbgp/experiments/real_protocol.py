@@ -15,6 +15,7 @@ the paper's with the sign of alpha flipped.
 
 from __future__ import annotations
 
+import concurrent.futures
 import math
 from pathlib import Path
 
@@ -79,10 +80,32 @@ def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, dist
     return loop.run()
 
 
+def method_rows(dynamics: str, method: str, policy_file=None, paths=None, steps: int = 60, seed: int = 0,
+                repeats: int = 1) -> tuple[list[dict], dict]:
+    """Every setting of ``paths`` for one method on one dynamics set: the table rows, and the first
+    run of each setting for the figures (``{path: {setting: episode}}``)."""
+    policy = make_policy(method, policy_file, robot="turtlebot2", transfer=True)  # the paper: zero-shot
+    rows, pictures = [], {}
+    for path in paths or PATHS:
+        for setting in SETTINGS[path]:
+            collector = TrajectoryCollector()
+            runs = [run_setting(policy, path, setting, steps, seed + r, collector=collector, dynamics=dynamics)
+                    for r in range(repeats)]
+            rows.append({"path": path, "setting": setting, "method": method, "dynamics": dynamics, **aggregate(runs)})
+            pictures.setdefault(path, {})[setting] = collector.episodes[0]
+    return rows, pictures
+
+
+def _method_rows(job: tuple) -> tuple[list[dict], dict]:
+    return method_rows(*job)
+
+
 def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods=METHODS, paths=None, policies=None,
-                      repeats: int = 1, command: str = "", dynamics_sets=DYNAMICS_SETS) -> list[dict]:
+                      repeats: int = 1, command: str = "", dynamics_sets=DYNAMICS_SETS, jobs: int = 1) -> list[dict]:
     """The protocol on each dynamics set (nominal: real_protocol_table.md; hardware_like:
-    real_protocol_hardware_table.md) and each method's sim-to-real loss (real_protocol_gap.md)."""
+    real_protocol_hardware_table.md) and each method's sim-to-real loss (real_protocol_gap.md).
+    ``jobs`` > 1 runs the (dynamics set, method) pairs in that many processes: the same runs, the
+    same numbers."""
     out_dir = Path(out_dir)
     policies = policies or {}
     paths = list(paths or PATHS)
@@ -92,22 +115,21 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
     bad = [d for d in dynamics_sets if d not in DYNAMICS_SETS]
     if bad or not dynamics_sets:
         raise ValueError(f"unknown dynamics set(s) {bad}; use {', '.join(DYNAMICS_SETS)}")
+    work = [(dynamics, method, policies.get(method), paths, steps, seed, repeats) for dynamics in dynamics_sets for method in methods]
+    if jobs > 1:
+        with concurrent.futures.ProcessPoolExecutor(min(jobs, len(work))) as pool:
+            done = list(pool.map(_method_rows, work))
+    else:
+        done = [_method_rows(job) for job in work]
     all_rows = {}
     for dynamics in dynamics_sets:
-        rows, pictures = [], {}
-        for method in methods:
-            policy = make_policy(method, policies.get(method), robot="turtlebot2", transfer=True)  # the paper: zero-shot
-            for path in paths:
-                for setting in SETTINGS[path]:
-                    collector = TrajectoryCollector()
-                    runs = [run_setting(policy, path, setting, steps, seed + r, collector=collector, dynamics=dynamics)
-                            for r in range(repeats)]
-                    rows.append({"path": path, "setting": setting, "method": method, "dynamics": dynamics, **aggregate(runs)})
-                    pictures.setdefault(path, {}).setdefault(setting, {})[method.upper()] = collector.episodes[0]
+        results = {job[1]: result for job, result in zip(work, done) if job[0] == dynamics}  # method -> (rows, pictures)
+        rows = [row for rows_of_method, _ in results.values() for row in rows_of_method]
         all_rows[dynamics] = rows
         suffix = "" if dynamics == "nominal" else "_hardware"
-        for path, by_setting in pictures.items():
-            for setting, panels in by_setting.items():
+        for path in paths:
+            for setting in SETTINGS[path]:
+                panels = {method.upper(): pictures[path][setting] for method, (_, pictures) in results.items()}
                 plot_trajectories(panels, out_dir / "figures" / f"real_protocol{suffix}_{path}_{setting}.png",
                                   title=f"{path}, {setting} (TurtleBot 2, {dynamics} dynamics, simulated mocap)")
         robot_words = ("the nominal TurtleBot 2 model (the dynamics the simulator trains on)" if dynamics == "nominal" else

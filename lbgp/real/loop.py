@@ -37,7 +37,7 @@ from lbgp.geometry import distance_and_alpha
 from lbgp.metrics import EpisodeMetrics
 from lbgp.planner import clamp_command
 from lbgp.real import safety as safety_lib
-from lbgp.real.safety import SafetyConfig, SafetyMonitor
+from lbgp.real.safety import SafetyConfig, SafetyMonitor, too_close_distance
 from lbgp.sim import observation as obs_lib
 from lbgp.sim.rewards import follow_ahead_reward
 from lbgp.world import WorldState
@@ -118,7 +118,7 @@ class DeployLoop:
         self.controller = stack.make_controller(policy.control, self.limits, self.cfg.drive_model)
         self.cfg.calibration.reset()  # an online calibration starts each run afresh
         self.monitor = SafetyMonitor(self.cfg.safety)
-        self.min_distance = self.cfg.safety.min_distance or self.limits.safety_distance
+        self.min_distance = self.cfg.safety.min_distance or too_close_distance(self.limits)
         self.stack = obs_lib.ObservationStack()
         self.name = name  # the run's name in the metrics and the recording
         self.metrics = EpisodeMetrics(setting=name)

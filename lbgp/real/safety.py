@@ -51,8 +51,9 @@ def too_close_distance(limits) -> float:
     """The default ``too_close`` distance (robot centre to person centre) for a robot with these
     planner limits (``lbgp.planner.PlannerConfig``): footprint + person radius + half the safety
     margin. The planner keeps the full safety distance, letting the next pose dip at most
-    ``clearance_tolerance`` into it, so normal driving never comes this close; the other half of the
-    margin still lies between this stop and contact with a disc-shaped person."""
+    ``clearance_tolerance`` into it, so its plans stay out of this distance (a robot slower to respond
+    than the planner assumes can still come closer: the drive model, lbgp.drive_model, is for that);
+    the other half of the margin still lies between this stop and contact with a disc-shaped person."""
     return limits.safety_distance - 0.5 * limits.safety_margin
 
 

@@ -239,14 +239,10 @@ def test_the_too_close_stop_stays_out_of_the_planners_way_while_it_passes_a_turn
     person at its safety distance. A too_close stop at that distance halted the robot in the
     person's path and the person walked into it (this run, and 19 of 20 HC runs); the default stop
     distance lies inside the planner's band, so it never fires here, and still outside contact."""
-    from lbgp.experiments.real_protocol import PATHS, SETTINGS
+    from lbgp.experiments.real_protocol import protocol_loop
     from lbgp.policies import make_policy
-    from lbgp.real.sim_world import MocapDisturbance, SimCommandSink, SimPoseSource, SimWorld
 
-    world = SimWorld(robot="turtlebot2", seed=1, person_path=PATHS["u_turn"](), spawn=SETTINGS["u_turn"]["ahead_left"])
-    loop = DeployLoop(SimPoseSource(world, MocapDisturbance(), seed=1), SimCommandSink(world), make_policy("hc", robot="turtlebot2"),
-                      DeployConfig(robot="turtlebot2", max_steps=60, end_distance=3.0),
-                      end_condition=lambda: "contact" if world.contact else None)
+    loop = protocol_loop(make_policy("hc", robot="turtlebot2"), "u_turn", "ahead_left", steps=60, seed=1, keep_records=True)
     metrics = loop.run()
     limits = loop.limits
     assert limits.footprint_radius + limits.person_radius < loop.min_distance < limits.safety_distance - limits.clearance_tolerance

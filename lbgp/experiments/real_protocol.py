@@ -64,20 +64,26 @@ SETTINGS = {
 DYNAMICS_SETS = ("nominal", "hardware_like")  # lbgp.dynamics: the trained-on model and the held-out "real" one
 
 
-def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None,
-                calibration=None, drive_model=None):
-    """One run of the protocol through the deployment loop; returns its EpisodeMetrics.
-    ``calibration``: the command calibration (``lbgp.calibration``) of the deploy loop;
-    ``drive_model``: its planner's model of the drive (``lbgp.drive_model``)."""
+def protocol_loop(policy, path: str, setting: str, steps: int, seed: int = 0, disturbance=None, collector=None, dynamics=None,
+                  calibration=None, drive_model=None, keep_records: bool = False) -> DeployLoop:
+    """One run of the protocol, set up and not yet run: the deployment loop on a simulated TurtleBot 2
+    with simulated mocap. ``calibration``: the command calibration (``lbgp.calibration``) of the deploy
+    loop; ``drive_model``: its planner's model of the drive (``lbgp.drive_model``); ``keep_records``:
+    keep every tick's record (``loop.records``)."""
     world = SimWorld(robot="turtlebot2", seed=seed, person_path=PATHS[path](), spawn=SETTINGS[path][setting], dynamics=dynamics)
     source = SimPoseSource(world, disturbance if disturbance is not None else MocapDisturbance(), seed=seed)
     config = DeployConfig(robot="turtlebot2", max_steps=steps, end_distance=END_DISTANCE,
                           calibration=load_calibration(calibration, "turtlebot2"),
                           drive_model=load_drive_model(drive_model, "turtlebot2"))
-    loop = DeployLoop(source, SimCommandSink(world), policy, config,
-                      recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=False,
+    return DeployLoop(source, SimCommandSink(world), policy, config,
+                      recorder=collector, end_condition=lambda: "contact" if world.contact else None, keep_records=keep_records,
                       name=f"{path}/{setting}")
-    return loop.run()
+
+
+def run_setting(policy, path: str, setting: str, steps: int, seed: int = 0, **kwargs):
+    """One run of the protocol through the deployment loop (``protocol_loop``'s options); returns its
+    EpisodeMetrics."""
+    return protocol_loop(policy, path, setting, steps, seed, **kwargs).run()
 
 
 def method_rows(dynamics: str, method: str, policy_file=None, paths=None, steps: int = 60, seed: int = 0,
@@ -94,10 +100,6 @@ def method_rows(dynamics: str, method: str, policy_file=None, paths=None, steps:
             rows.append({"path": path, "setting": setting, "method": method, "dynamics": dynamics, **aggregate(runs)})
             pictures.setdefault(path, {})[setting] = collector.episodes[0]
     return rows, pictures
-
-
-def _method_rows(job: tuple) -> tuple[list[dict], dict]:
-    return method_rows(*job)
 
 
 def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods=METHODS, paths=None, policies=None,
@@ -118,9 +120,9 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
     work = [(dynamics, method, policies.get(method), paths, steps, seed, repeats) for dynamics in dynamics_sets for method in methods]
     if jobs > 1:
         with concurrent.futures.ProcessPoolExecutor(min(jobs, len(work))) as pool:
-            done = list(pool.map(_method_rows, work))
+            done = list(pool.map(method_rows, *zip(*work)))
     else:
-        done = [_method_rows(job) for job in work]
+        done = [method_rows(*job) for job in work]
     all_rows = {}
     for dynamics in dynamics_sets:
         results = {job[1]: result for job, result in zip(work, done) if job[0] == dynamics}  # method -> (rows, pictures)

@@ -47,6 +47,9 @@ class VelocityController:
         v, w = clamp_command(self._vw[0], self._vw[1], v_now, w_now, self.limits)
         return Command(v, w)
 
+    def sent(self, t: float, v: float, w: float) -> None:
+        """A command sent at ``t`` that did not come from ``command`` (a safety stop): nothing to track."""
+
 
 class GoalController:
     """LBGP/HC: the action is a goal in the person frame; the TEB planner drives there.
@@ -84,6 +87,11 @@ class GoalController:
             seen.robot_pose, seen.robot_velocity, goal, seen.person_pose, seen.person_velocity,
             person_turn_rate=seen.person_turn_rate, goal_moves_with_person=True,
         )
-        if self.prediction is not None:
-            self.prediction.sent(state.t, plan.v, plan.w)
+        self.sent(state.t, plan.v, plan.w)
         return Command(plan.v, plan.w, plan.status, goal, plan)
+
+    def sent(self, t: float, v: float, w: float) -> None:
+        """A command sent at ``t`` (``command`` reports its own; the deploy loop reports its safety
+        stops): the drive model's commands in flight."""
+        if self.prediction is not None:
+            self.prediction.sent(t, v, w)

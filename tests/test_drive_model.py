@@ -144,3 +144,43 @@ def test_cli_takes_a_sysid_file_as_drive_model_and_refuses_a_bad_one(tmp_path, c
     assert "latency" in capsys.readouterr().err
     assert main(["evaluate", "--drive-model", str(tmp_path / "missing.json")]) == 2
     assert "missing.json: no such file" in capsys.readouterr().err
+
+
+def test_the_deploy_loops_safety_stop_is_a_command_in_flight_for_the_drive_model():
+    """After a too_close stop the base is braking: the prediction must integrate the stop ramp the
+    loop sent, not the last planned command (which would predict the robot still driving)."""
+    from lbgp.real.frames import PoseFrame
+    from lbgp.real.loop import DeployConfig, DeployLoop
+    from lbgp.real.replay import ReplayClock
+    from lbgp.real.safety import TOO_CLOSE
+    from lbgp.rollout import ConstantGoalPolicy
+
+    class Scripted:
+        clock = ReplayClock()
+        person = np.array([-1.5, 0.0, 0.0])
+
+        def poll(self, now, timeout=0.0):
+            return [PoseFrame(now + 100.0, np.zeros(3), self.person.copy(), now)]  # its own clock, 100 s ahead
+
+    class Sink:
+        def send(self, t, v, w, status="ok"):
+            pass
+
+    source = Scripted()
+    config = DeployConfig(robot="turtlebot2", drive_model=Dynamics(latency=0.2))
+    loop = DeployLoop(source, Sink(), ConstantGoalPolicy((3.0, 0.0)), config, clock=source.clock)
+    for k in range(10):
+        source.clock.sleep_until(0.1 * k)
+        assert loop.tick().status == "ok"
+    assert loop.command[0] > 0.2  # driving towards the goal 1.5 m ahead
+    driving = state(100.9)
+    ahead = loop.controller.prediction.predict(driving).robot_pose[0]
+    assert ahead > 0.03  # in flight: 0.2 s of driving
+
+    source.person = np.array([-0.3, 0.0, 0.0])  # the person steps up to the robot
+    for k in range(10, 15):
+        source.clock.sleep_until(0.1 * k)
+        assert loop.tick().status == TOO_CLOSE
+    assert loop.command == (0.0, 0.0)
+    stopped = loop.controller.prediction.predict(state(101.4)).robot_pose[0]
+    assert stopped == pytest.approx(0.0, abs=1e-6)  # the stop ramp has arrived: the robot is predicted still

@@ -131,6 +131,7 @@ class DeployLoop:
         self._last_agent_t = -math.inf
         self._last_good = -math.inf
         self._was_within = False
+        self._source_minus_loop = None  # source time - loop time at the last valid frame (commands in source time)
         self.on_wait = on_wait  # optional callable(message): told once a second while no valid pose has arrived
         self._next_wait_note = 0.0
 
@@ -163,6 +164,7 @@ class DeployLoop:
             if not self._people or self._people[-1][0] < frame.t:
                 self._people.append((frame.t, frame.person.copy()))
             record.robot, record.person = frame.robot.copy(), frame.person.copy()
+            self._source_minus_loop = frame.t - now
             distance, alpha = record.distance_alpha = distance_and_alpha(frame.robot, frame.person)
             if distance < self.min_distance:
                 status = record.status = safety_lib.TOO_CLOSE
@@ -185,6 +187,8 @@ class DeployLoop:
             record.band = None if cmd.plan is None else cmd.plan.poses.copy()
         else:
             v, w = self._stop_command()
+            if self._source_minus_loop is not None:  # the drive model must know the stop is in flight
+                self.controller.sent(now + self._source_minus_loop, v, w)
         self.command = (v, w)  # the planner's limits chain from its own command, before calibration
         if status == safety_lib.OK:
             self.cfg.calibration.observe(frame.t, frame.robot)  # an online calibration learns from the measured motion

@@ -100,7 +100,8 @@ def test_ablation_on_a_tiny_budget(tmp_path):
     assert report["runs"]["E2E_s0"]["method"] == "e2e"
     assert (tmp_path / "ablation_curves.png").stat().st_size > 5_000
     kept = tmp_path / "ablation_runs" / "E2E_s0"
-    assert sorted(p.name for p in kept.iterdir()) == ["config.json", "curve.csv", "summary.json"]
+    assert sorted(p.name for p in kept.iterdir()) == ["config.json", "curve.csv", "policy.pt", "summary.json"]
+    assert (kept / "policy.pt").read_bytes() == (tmp_path / "runs" / "E2E_s0" / "policy.pt").read_bytes()
 
 
 def test_ablation_gives_every_variant_the_same_wall_time_and_e2e_steps_it_cannot_use_up():

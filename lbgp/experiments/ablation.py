@@ -8,8 +8,8 @@ easier levels (the paper plots it the same way). Runs live in ``runs/ablation`` 
 checkpoints hold the replay, ~100 MB each) and resume where they stopped.
 
 Nine 30-minute runs take 4.5 hours, more than one sitting on a fresh machine whose ``runs/`` is gone
-the next time. So every finished run's small files (config.json, curve.csv, summary.json) are kept
-beside the results, in ``ablation_runs/<run>/``, and a later call with the same settings reuses them
+the next time. So every finished run's small files (config.json, curve.csv, summary.json; also its
+policy.pt) are kept beside the results, in ``ablation_runs/<run>/``, and a later call with the same settings reuses them
 instead of training again; ``max_new_runs`` bounds how many runs one call trains. Runs go seed by
 seed (every variant's seed 0 first), so a partial ablation already compares the variants. Until all
 runs are there, ``ablation.json`` says ``complete: false`` and lists the missing ones.
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lbgp.files import write_json, write_text
+from lbgp.files import atomic_file, write_json, write_text
 from lbgp.metrics import reward_ci95
 
 from lbgp.agent.config import D4PGConfig
@@ -41,6 +41,7 @@ VARIANTS = {
 DEFAULT_RUNS_DIR = Path("runs") / "ablation"
 ARCHIVE_NAME = "ablation_runs"  # under the results folder: the finished runs' small files
 ARCHIVED_FILES = ("config.json", "curve.csv", "summary.json")
+POLICY_FILE = "policy.pt"  # also kept (~100 KB) for benchmarks/ablation_scenarios.py; not needed to reuse a run
 
 
 def archived_run(archive: Path, cfg: D4PGConfig) -> dict | None:
@@ -60,6 +61,9 @@ def archive_run(run: Path, archive: Path) -> None:
     """Copy a finished run's small files into ``archive``, each atomically (summary.json last: it
     marks the copy whole)."""
     (archive / "summary.json").unlink(missing_ok=True)
+    if (run / POLICY_FILE).is_file():
+        with atomic_file(archive / POLICY_FILE, "wb") as f:
+            f.write((run / POLICY_FILE).read_bytes())
     for name in ARCHIVED_FILES:
         write_text(archive / name, (run / name).read_text())
 

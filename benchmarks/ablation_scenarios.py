@@ -8,7 +8,8 @@ wide. This evaluates each run's final policy (``policy.pt``, kept with the run i
 ``results/ablation_runs/<run>/``) as ``lbgp experiment sim`` does: the 9 paper scenarios, Jackal,
 20 seeded episodes each with observation noise on, the same episodes for every policy. Per run:
 the mean accumulated reward per scenario and its sum over the scenarios; per variant: the mean of
-those sums over the seeds with a 95 % interval (t over the seeds). HC on the same episodes is the
+those sums over the seeds with a 95 % interval (t over the seeds), and each variant's difference to
+LBGP with Welch's 95 % interval ("separated" when it excludes 0). HC on the same episodes is the
 reference row (a fixed rule: one run).
 """
 
@@ -43,14 +44,34 @@ def variant_of(run: str) -> str:
 def score(job: tuple[str, str, str | None, list[str], int, int]) -> tuple[str, dict]:
     name, method, policy_file, scenarios, episodes, seed = job
     policy = make_policy(method, policy_file, robot="jackal")
-    rows = evaluate(policy, method, scenarios, robot="jackal", episodes=episodes, seed=seed, obs_noise=True)
+    # scenario k's episodes seeded as lbgp experiment sim seeds them: its rows are the same episodes
+    rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * scenario_names().index(name),
+                     obs_noise=True)[0] for name in scenarios]
     per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
     return name, {"method": method, "policy": policy_file, "per_scenario": per_scenario,
                   "sum": round(float(sum(per_scenario.values())), 3)}
 
 
-def summarise(scored: dict[str, dict]) -> dict[str, dict]:
-    """Per variant: its runs, their scenario sums, the mean sum and the 95 % half-width over the seeds."""
+def welch_difference(a: list[float], b: list[float]) -> tuple[float, float | None]:
+    """mean(a) - mean(b) and the half-width of its 95 % interval (Welch's t: unequal variances;
+    None with fewer than two values on a side)."""
+    from scipy import stats
+
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    diff = float(a.mean() - b.mean())
+    if a.size < 2 or b.size < 2:
+        return diff, None
+    va, vb = a.var(ddof=1) / a.size, b.var(ddof=1) / b.size
+    se2 = va + vb
+    if se2 == 0.0:
+        return diff, 0.0
+    dof = se2**2 / (va**2 / (a.size - 1) + vb**2 / (b.size - 1))
+    return diff, float(stats.t.ppf(0.975, dof) * np.sqrt(se2))
+
+
+def summarise(scored: dict[str, dict], reference: str = "LBGP") -> dict[str, dict]:
+    """Per variant: its runs, their scenario sums, the mean sum and the 95 % half-width over the
+    seeds, and (other variants) its difference to ``reference`` with Welch's 95 % interval."""
     variants: dict[str, dict] = {}
     for name, result in scored.items():
         v = variants.setdefault(variant_of(name), {"runs": [], "sums": []})
@@ -59,6 +80,11 @@ def summarise(scored: dict[str, dict]) -> dict[str, dict]:
     for v in variants.values():
         v["mean_sum"] = round(float(np.mean(v["sums"])), 3)
         v["ci95_half_width"] = round(reward_ci95(v["sums"]), 3) if len(v["sums"]) > 1 else None
+    for name, v in variants.items():
+        if name != reference and reference in variants:
+            diff, half = welch_difference(v["sums"], variants[reference]["sums"])
+            v[f"minus_{reference}"] = {"difference": round(diff, 3), "ci95_half_width": None if half is None else round(half, 3),
+                                       "separated": half is not None and abs(diff) > half}
     return variants
 
 

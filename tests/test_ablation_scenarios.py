@@ -20,15 +20,27 @@ def test_variants_are_summarised_over_their_seeds():
     assert out["LBGP"]["runs"] == ["LBGP_s0", "LBGP_s1"] and out["LBGP"]["mean_sum"] == 11.0
     assert out["LBGP"]["ci95_half_width"] == pytest.approx(12.706, abs=1e-3)  # t(0.975, 1) * std / sqrt(2), std = sqrt(2)
     assert out["E2E"]["mean_sum"] == 5.0 and out["E2E"]["ci95_half_width"] is None
+    assert out["E2E"]["minus_LBGP"] == {"difference": -6.0, "ci95_half_width": None, "separated": False}
+    assert "minus_LBGP" not in out["LBGP"]
 
 
-def test_each_runs_policy_faces_the_same_noisy_episodes_as_lbgp_evaluate(tmp_path):
+def test_welch_difference_separates_only_what_its_interval_excludes():
+    from ablation_scenarios import welch_difference
+
+    diff, half = welch_difference([10.0, 11.0, 12.0], [5.0, 7.0, 9.0])
+    # variances 1/3 and 4/3 per mean: se = sqrt(5/3); Welch dof = (5/3)^2 / ((1/3)^2/2 + (4/3)^2/2) = 2.94
+    assert diff == 4.0 and half == pytest.approx(4.1554, abs=1e-3)
+    assert welch_difference([1.0, 1.0], [1.0, 1.0]) == (0.0, 0.0)
+
+
+def test_each_runs_policy_faces_the_noisy_episodes_of_the_sim_table(tmp_path):
     runs = tmp_path / "ablation_runs"
     for run, method in (("LBGP_s0", "lbgp"), ("LBGP_s1", "lbgp"), ("E2E_s0", "e2e")):
         (runs / run).mkdir(parents=True)
         shutil.copy(default_policy_path(method), runs / run / "policy.pt")
     result = main(["--runs", str(runs), "--scenarios", "turning_ahead", "--episodes", "2", "--json", str(tmp_path / "out.json")])
-    (direct,) = evaluate(make_policy("lbgp"), "lbgp", ["turning_ahead"], episodes=2, seed=0, obs_noise=True)
+    # the episodes of lbgp experiment sim's turning_ahead row (scenario 2: seed 2000)
+    (direct,) = evaluate(make_policy("lbgp"), "lbgp", ["turning_ahead"], episodes=2, seed=2000, obs_noise=True)
     assert result["runs"]["LBGP_s0"]["sum"] == pytest.approx(direct["reward"], abs=1e-3)
     assert result["variants"]["LBGP"]["sums"] == [result["runs"]["LBGP_s0"]["sum"]] * 2  # the same policy twice
     assert result["variants"]["LBGP"]["ci95_half_width"] == 0.0

@@ -8,9 +8,10 @@ limiter, a motor lag: ``lbgp.dynamics``). Given a drive model, a ``Dynamics`` su
 1. plans within the drive's acceleration limits (the lower of the planner's and the firmware's), so
    the commands it sends are ones the base can follow, and
 2. plans from the robot's predicted state at the moment the command will act: the commands already
-   sent and still in flight (its own, and the deploy loop's safety stops) are run through the very drive train the simulator uses
-   (``lbgp.drive_train.DriveTrain``, without jitter) and integrated from the measured pose; the person
-   moves along their predicted arc (velocity and turn rate) over the same time.
+   sent and still in flight (its own, and the deploy loop's safety stops) are run through the very
+   drive train the simulator uses (``lbgp.drive_train.DriveTrain``, without jitter) and integrated
+   from the measured pose; the person moves along their predicted arc (velocity and turn rate) over
+   the same time.
 
 The prediction is open-loop over one latency only (0.1 s on the hardware-like robots), from the
 newest measured pose at every call, so its errors do not accumulate. Sim and real use it alike: the

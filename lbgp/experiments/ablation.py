@@ -9,10 +9,11 @@ checkpoints hold the replay, ~100 MB each) and resume where they stopped.
 
 Nine 30-minute runs take 4.5 hours, more than one sitting on a fresh machine whose ``runs/`` is gone
 the next time. So every finished run's small files (config.json, curve.csv, summary.json; also its
-policy.pt) are kept beside the results, in ``ablation_runs/<run>/``, and a later call with the same settings reuses them
-instead of training again; ``max_new_runs`` bounds how many runs one call trains. Runs go seed by
-seed (every variant's seed 0 first), so a partial ablation already compares the variants. Until all
-runs are there, ``ablation.json`` says ``complete: false`` and lists the missing ones.
+policy.pt) are kept beside the results, in ``ablation_runs/<run>/``, and a later call with the same
+settings reuses them instead of training again; ``max_new_runs`` bounds how many runs one call
+trains. Runs go seed by seed (every variant's seed 0 first), so a partial ablation already compares
+the variants. Until all runs are there, ``ablation.json`` says ``complete: false`` and lists the
+missing ones.
 """
 
 from __future__ import annotations

@@ -11,11 +11,16 @@ the mean accumulated reward per scenario and its sum over the scenarios; per var
 those sums over the seeds with a 95 % interval (t over the seeds), and each variant's difference to
 LBGP with Welch's 95 % interval ("separated" when it excludes 0). HC on the same episodes is the
 reference row (a fixed rule: one run).
+
+``--deadbands 0,0.1,0.2`` also scores every LBGP run (with and without curriculum) at each goal dead
+band (lbgp.agent.policy.GOAL_DEADBAND_M; the default one keeps the plain variant name, the others
+are variants ``<variant>@deadband<d>``): the ablation of that choice over the same seeds.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -25,6 +30,7 @@ from _common import write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from lbgp.agent.policy import GOAL_DEADBAND_M  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -41,14 +47,22 @@ def variant_of(run: str) -> str:
     return run.rsplit("_s", 1)[0]
 
 
-def score(job: tuple[str, str, str | None, list[str], int, int]) -> tuple[str, dict]:
-    name, method, policy_file, scenarios, episodes, seed = job
-    policy = make_policy(method, policy_file, robot="jackal")
+def deadband_run_name(run: str, deadband: float, default: float) -> str:
+    """``LBGP_s1`` at the default dead band stays ``LBGP_s1``; at 0 m it is ``LBGP@deadband0_s1``."""
+    if deadband == default:
+        return run
+    variant, seed = run.rsplit("_s", 1)
+    return f"{variant}@deadband{deadband:g}_s{seed}"
+
+
+def score(job: tuple[str, str, str | None, list[str], int, int, float | None]) -> tuple[str, dict]:
+    name, method, policy_file, scenarios, episodes, seed, deadband = job
+    policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband)
     # scenario k's episodes seeded as lbgp experiment sim seeds them: its rows are the same episodes
     rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * scenario_names().index(name),
                      obs_noise=True)[0] for name in scenarios]
     per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
-    return name, {"method": method, "policy": policy_file, "per_scenario": per_scenario,
+    return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None), "per_scenario": per_scenario,
                   "sum": round(float(sum(per_scenario.values())), 3)}
 
 
@@ -71,7 +85,9 @@ def welch_difference(a: list[float], b: list[float]) -> tuple[float, float | Non
 
 def summarise(scored: dict[str, dict], reference: str = "LBGP") -> dict[str, dict]:
     """Per variant: its runs, their scenario sums, the mean sum and the 95 % half-width over the
-    seeds, and (other variants) its difference to ``reference`` with Welch's 95 % interval."""
+    seeds, and (other variants) its difference to ``reference`` with Welch's 95 % interval. A dead
+    band variant ``X@deadband<d>`` is the same trained policies as ``X``: its difference to ``X`` is
+    also given paired by seed (``minus_X_paired``: mean of the per-seed differences, t interval)."""
     variants: dict[str, dict] = {}
     for name, result in scored.items():
         v = variants.setdefault(variant_of(name), {"runs": [], "sums": []})
@@ -85,7 +101,23 @@ def summarise(scored: dict[str, dict], reference: str = "LBGP") -> dict[str, dic
             diff, half = welch_difference(v["sums"], variants[reference]["sums"])
             v[f"minus_{reference}"] = {"difference": round(diff, 3), "ci95_half_width": None if half is None else round(half, 3),
                                        "separated": half is not None and abs(diff) > half}
+        base = name.split("@", 1)[0]
+        if base != name and base in variants:
+            v[f"minus_{base}_paired"] = paired_difference(dict(zip(v["runs"], v["sums"])),
+                                                          dict(zip(variants[base]["runs"], variants[base]["sums"])))
     return variants
+
+
+def paired_difference(sums: dict[str, float], base_sums: dict[str, float]) -> dict:
+    """Per seed ``sums[X@..._s<k>] - base_sums[X_s<k>]``: their mean and the 95 % t half-width (None
+    with fewer than two seeds in common)."""
+    seed_of = lambda run: run.rsplit("_s", 1)[1]  # noqa: E731
+    base_by_seed = {seed_of(r): x for r, x in base_sums.items()}
+    diffs = [x - base_by_seed[seed_of(r)] for r, x in sums.items() if seed_of(r) in base_by_seed]
+    half = round(reward_ci95(diffs), 3) if len(diffs) > 1 else None
+    mean = round(float(np.mean(diffs)), 3) if diffs else None
+    return {"per_seed": [round(d, 3) for d in diffs], "difference": mean, "ci95_half_width": half,
+            "separated": half is not None and abs(mean) > half}
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -96,14 +128,27 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--deadbands", default=str(GOAL_DEADBAND_M), help="comma-separated goal dead bands (m) for the LBGP runs")
+    ap.add_argument("--resummarise", action="store_true",
+                    help="no scoring: summarise the runs already in --json again (after a change to the summary only)")
     args = ap.parse_args(argv)
+    if args.resummarise:
+        result = json.loads(Path(args.json).read_text())
+        result["variants"] = summarise(result["runs"])
+        write_result(args.json, result)
+        return result
     scenarios = args.scenarios.split(",")
+    deadbands = [float(d) for d in args.deadbands.split(",")]
     policies = run_policies(Path(args.runs))
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
-    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed)]
+    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None)]
     for name, path in policies.items():
-        jobs.append((name, "e2e" if variant_of(name) == "E2E" else "lbgp", str(path), scenarios, args.episodes, args.seed))
+        if variant_of(name) == "E2E":
+            jobs.append((name, "e2e", str(path), scenarios, args.episodes, args.seed, None))
+            continue
+        for d in deadbands:
+            jobs.append((deadband_run_name(name, d, GOAL_DEADBAND_M), "lbgp", str(path), scenarios, args.episodes, args.seed, d))
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")

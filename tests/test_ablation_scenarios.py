@@ -8,7 +8,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from ablation_scenarios import main, summarise, variant_of  # noqa: E402
+from ablation_scenarios import deadband_run_name, main, summarise, variant_of  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
@@ -22,6 +22,24 @@ def test_variants_are_summarised_over_their_seeds():
     assert out["E2E"]["mean_sum"] == 5.0 and out["E2E"]["ci95_half_width"] is None
     assert out["E2E"]["minus_LBGP"] == {"difference": -6.0, "ci95_half_width": None, "separated": False}
     assert "minus_LBGP" not in out["LBGP"]
+
+
+def test_a_runs_other_goal_dead_bands_are_variants_of_their_own():
+    assert deadband_run_name("LBGP_s1", 0.1, default=0.1) == "LBGP_s1"
+    assert deadband_run_name("LBGP-no-curriculum_s2", 0.0, default=0.1) == "LBGP-no-curriculum@deadband0_s2"
+    assert variant_of(deadband_run_name("LBGP_s1", 0.2, default=0.1)) == "LBGP@deadband0.2"
+
+
+def test_a_dead_band_variant_is_compared_with_its_own_policies_seed_by_seed():
+    out = summarise({"LBGP_s0": {"sum": 10.0}, "LBGP_s1": {"sum": 20.0}, "LBGP_s2": {"sum": 15.0},
+                     "LBGP@deadband0_s0": {"sum": 9.0}, "LBGP@deadband0_s1": {"sum": 18.0}, "LBGP@deadband0_s2": {"sum": 14.0}})
+    paired = out["LBGP@deadband0"]["minus_LBGP_paired"]
+    # differences -1, -2, -1: mean -4/3, std 1/sqrt(3), t(0.975, 2) = 4.303 -> half-width 4.303 / 3 = 1.434
+    assert paired["per_seed"] == [-1.0, -2.0, -1.0] and paired["difference"] == pytest.approx(-1.333, abs=1e-3)
+    assert paired["ci95_half_width"] == pytest.approx(1.434, abs=1e-3) and not paired["separated"]
+    # Welch's interval for the same numbers is far wider: the seeds' spread dominates it
+    assert out["LBGP@deadband0"]["minus_LBGP"]["ci95_half_width"] > 10.0
+    assert "minus_LBGP_paired" not in out["LBGP"]
 
 
 def test_welch_difference_separates_only_what_its_interval_excludes():

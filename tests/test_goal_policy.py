@@ -110,5 +110,45 @@ def test_residual_policy_file_round_trips(tmp_path):
     save_policy(tmp_path / "r.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
     obs = np.random.default_rng(1).uniform(-1, 1, obs_lib.SIZE).astype(np.float32)
     expected = actor(torch.from_numpy(obs)[None])[0].detach().numpy()
-    assert np.allclose(load_policy(tmp_path / "r.pt").act(obs), expected, atol=1e-6)
+    assert np.allclose(load_policy(tmp_path / "r.pt", goal_deadband=0.0).act(obs), expected, atol=1e-6)
     assert not np.allclose(expected, action_from_goal(DESIRED_GOAL))
+
+
+def _residual_policy_file(tmp_path, bias_x: float, bias_y: float):
+    torch.manual_seed(0)
+    actor = make_actor(D4PGConfig(hidden=(8,)), obs_lib.SIZE, 2)
+    with torch.no_grad():  # a constant residual whatever the observation
+        actor.net[-1].weight.zero_()
+        actor.net[-1].bias.copy_(torch.tensor([bias_x, bias_y]))
+    save_policy(tmp_path / "r.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
+    return tmp_path / "r.pt"
+
+
+def test_goal_dead_band_shrinks_the_residual_goal_toward_the_goal_ahead(tmp_path):
+    obs = np.zeros(obs_lib.SIZE, np.float32)
+    ahead = np.asarray(DESIRED_GOAL)
+    # residual 0.75 m * tanh(b): b = atanh(0.08 / 0.75) gives 8 cm straight to the left
+    small = _residual_policy_file(tmp_path, 0.0, math.atanh(0.08 / 0.75))
+    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.0).act(obs)), ahead + [0.0, 0.08], atol=1e-5)
+    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.1).act(obs)), ahead, atol=1e-6)
+    # a 0.3 m, 0.4 m residual (length 0.5 m) keeps its direction and loses 0.1 m of its length
+    big = _residual_policy_file(tmp_path, math.atanh(0.3 / 0.75), math.atanh(0.4 / 0.75))
+    assert np.allclose(goal_from_action(load_policy(big, goal_deadband=0.1).act(obs)), ahead + [0.24, 0.32], atol=1e-5)
+    assert np.allclose(goal_from_action(load_policy(big).act(obs)), ahead + [0.24, 0.32], atol=1e-5)  # the default: 0.1 m
+    with pytest.raises(ValueError, match="goal_deadband"):
+        load_policy(big, goal_deadband=float("nan"))
+    with pytest.raises(ValueError, match="goal_deadband"):
+        load_policy(big, goal_deadband=-0.1)
+
+
+def test_goal_dead_band_leaves_plain_actors_and_e2e_alone(tmp_path):
+    torch.manual_seed(0)
+    obs = np.random.default_rng(2).uniform(-1, 1, obs_lib.SIZE).astype(np.float32)
+    for method in ("lbgp", "e2e"):  # plain tanh actors: no base goal to shrink toward
+        actor = Actor(obs_lib.SIZE, 2, (8,))
+        with torch.no_grad():
+            actor.net[-1].bias.fill_(0.05)
+        save_policy(tmp_path / f"{method}.pt", actor, method, "jackal", (8,))
+        policy = load_policy(tmp_path / f"{method}.pt", goal_deadband=0.5)
+        assert policy.goal_deadband == 0.0
+        assert np.allclose(policy.act(obs), actor(torch.from_numpy(obs)[None])[0].detach().numpy(), atol=1e-6)

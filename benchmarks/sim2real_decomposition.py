@@ -39,32 +39,34 @@ def groups(robot: str) -> dict[str, Dynamics]:
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", default="results/sim2real_decomposition.json")
     ap.add_argument("--episodes", type=int, default=6, help="episodes per scenario and dynamics set")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--methods", default="lbgp,hc")
-    args = ap.parse_args()
+    ap.add_argument("--scenarios", default=",".join(scenario_names()), help="comma-separated (default: the 9 paper scenarios)")
+    args = ap.parse_args(argv)
     robot = "jackal"
-    calibration, identified = identified_calibration(robot)
+    calibration, _drive_model, identified = identified_calibration(robot)
     runs = {"nominal": ("nominal", None), "hardware_like": ("hardware_like", None),
             "hardware_like_calibrated": ("hardware_like", calibration),
             **{f"only_{name}": (dyn, None) for name, dyn in groups(robot).items()}}
-    result = {"command": "python benchmarks/sim2real_decomposition.py " + " ".join(sys.argv[1:]), "robot": robot,
+    result = {"command": "python benchmarks/sim2real_decomposition.py " + " ".join(sys.argv[1:] if argv is None else argv), "robot": robot,
               "episodes": args.episodes, "calibration": identified, "methods": {}}
     t0 = time.perf_counter()
     for method in args.methods.split(","):
         policy = make_policy(method, robot=robot)
         sums = {}
         for name, (dynamics, cal) in runs.items():
-            rows = evaluate(policy, method, scenario_names(), robot=robot, episodes=args.episodes, seed=args.seed,
+            rows = evaluate(policy, method, args.scenarios.split(","), robot=robot, episodes=args.episodes, seed=args.seed,
                             obs_noise=True, dynamics=dynamics, calibration=cal)
             sums[name] = round(sum(r["reward"] for r in rows), 2)
             print(f"{method} {name}: {sums[name]}", file=sys.stderr, flush=True)
         result["methods"][method] = {"reward": sums, "loss_vs_nominal": {k: round(sums["nominal"] - v, 2) for k, v in sums.items()}}
     result["wall_time_s"] = round(time.perf_counter() - t0, 1)
     write_result(args.json, result)
+    return result
 
 
 if __name__ == "__main__":

@@ -59,6 +59,19 @@ def test_evaluate_writes_the_documented_json(tmp_path):
     assert "world/robot" in entity_paths_in(rrd)
 
 
+def test_evaluate_goal_deadband_option_reaches_the_lbgp_policy(tmp_path):
+    rewards = {}
+    for band in ("0", "0.1", "1.0"):
+        out = tmp_path / f"m{band}.json"
+        assert main(["evaluate", "--method", "lbgp", "--scenario", "turning_ahead", "--episodes", "1", "--goal-deadband", band,
+                     "--json", str(out)]) == 0
+        rewards[band] = json.loads(out.read_text())[0]["reward"]
+    assert len(set(rewards.values())) == 3  # the raw actor, the default band, and a band that swallows every residual
+    out = tmp_path / "default.json"
+    assert main(["evaluate", "--method", "lbgp", "--scenario", "turning_ahead", "--episodes", "1", "--json", str(out)]) == 0
+    assert json.loads(out.read_text())[0]["reward"] == rewards["0.1"]  # 0.1 m is the default
+
+
 def test_evaluate_rejects_unknown_scenarios(capsys):
     assert main(["evaluate", "--method", "scripted", "--scenario", "moonwalk"]) == 2
     assert "unknown scenario 'moonwalk'" in capsys.readouterr().err

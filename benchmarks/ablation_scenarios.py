@@ -47,12 +47,16 @@ def variant_of(run: str) -> str:
     return run.rsplit("_s", 1)[0]
 
 
+def seed_of(run: str) -> str:
+    """``LBGP-no-curriculum_s2`` -> ``2``."""
+    return run.rsplit("_s", 1)[1]
+
+
 def deadband_run_name(run: str, deadband: float, default: float) -> str:
     """``LBGP_s1`` at the default dead band stays ``LBGP_s1``; at 0 m it is ``LBGP@deadband0_s1``."""
     if deadband == default:
         return run
-    variant, seed = run.rsplit("_s", 1)
-    return f"{variant}@deadband{deadband:g}_s{seed}"
+    return f"{variant_of(run)}@deadband{deadband:g}_s{seed_of(run)}"
 
 
 def score(job: tuple[str, str, str | None, list[str], int, int, float | None]) -> tuple[str, dict]:
@@ -111,7 +115,6 @@ def summarise(scored: dict[str, dict], reference: str = "LBGP") -> dict[str, dic
 def paired_difference(sums: dict[str, float], base_sums: dict[str, float]) -> dict:
     """Per seed ``sums[X@..._s<k>] - base_sums[X_s<k>]``: their mean and the 95 % t half-width (None
     with fewer than two seeds in common)."""
-    seed_of = lambda run: run.rsplit("_s", 1)[1]  # noqa: E731
     base_by_seed = {seed_of(r): x for r, x in base_sums.items()}
     diffs = [x - base_by_seed[seed_of(r)] for r, x in sums.items() if seed_of(r) in base_by_seed]
     half = round(reward_ci95(diffs), 3) if len(diffs) > 1 else None

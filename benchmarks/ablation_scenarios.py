@@ -15,6 +15,10 @@ reference row (a fixed rule: one run).
 ``--deadbands 0,0.1,0.2`` also scores every LBGP run (with and without curriculum) at each goal dead
 band (lbgp.agent.policy.GOAL_DEADBAND_M; the default one keeps the plain variant name, the others
 are variants ``<variant>@deadband<d>``): the ablation of that choice over the same seeds.
+``--mirror on,off`` likewise scores every run (E2E included) with and without mirror-averaged
+acting (lbgp.agent.policy.MIRROR_AVERAGE; the default keeps the plain name, the other is
+``<variant>@nomirror`` or ``<variant>@mirror``). The two choices combine: ``LBGP@deadband0@nomirror``
+is the actor's own raw answer.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ from _common import write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from lbgp.agent.policy import GOAL_DEADBAND_M  # noqa: E402
+from lbgp.agent.policy import GOAL_DEADBAND_M, MIRROR_AVERAGE  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -52,21 +56,25 @@ def seed_of(run: str) -> str:
     return run.rsplit("_s", 1)[1]
 
 
-def deadband_run_name(run: str, deadband: float, default: float) -> str:
-    """``LBGP_s1`` at the default dead band stays ``LBGP_s1``; at 0 m it is ``LBGP@deadband0_s1``."""
-    if deadband == default:
-        return run
-    return f"{variant_of(run)}@deadband{deadband:g}_s{seed_of(run)}"
+def acting_run_name(run: str, deadband: float | None = None, mirror: bool = MIRROR_AVERAGE) -> str:
+    """``LBGP_s1`` acting with the defaults stays ``LBGP_s1``; at a 0 m dead band it is
+    ``LBGP@deadband0_s1``, without mirror averaging ``LBGP@nomirror_s1`` (both:
+    ``LBGP@deadband0@nomirror_s1``). ``deadband`` None: the default."""
+    tags = "" if deadband is None or deadband == GOAL_DEADBAND_M else f"@deadband{deadband:g}"
+    if mirror != MIRROR_AVERAGE:
+        tags += "@mirror" if mirror else "@nomirror"
+    return f"{variant_of(run)}{tags}_s{seed_of(run)}" if tags else run
 
 
-def score(job: tuple[str, str, str | None, list[str], int, int, float | None]) -> tuple[str, dict]:
-    name, method, policy_file, scenarios, episodes, seed, deadband = job
-    policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband)
+def score(job: tuple[str, str, str | None, list[str], int, int, float | None, bool]) -> tuple[str, dict]:
+    name, method, policy_file, scenarios, episodes, seed, deadband, mirror = job
+    policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
     # scenario k's episodes seeded as lbgp experiment sim seeds them: its rows are the same episodes
     rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * scenario_names().index(name),
                      obs_noise=True)[0] for name in scenarios]
     per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
-    return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None), "per_scenario": per_scenario,
+    return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
+                  "mirror_average": getattr(policy, "mirror_average", None), "per_scenario": per_scenario,
                   "sum": round(float(sum(per_scenario.values())), 3)}
 
 
@@ -89,8 +97,8 @@ def welch_difference(a: list[float], b: list[float]) -> tuple[float, float | Non
 
 def summarise(scored: dict[str, dict], reference: str = "LBGP") -> dict[str, dict]:
     """Per variant: its runs, their scenario sums, the mean sum and the 95 % half-width over the
-    seeds, and (other variants) its difference to ``reference`` with Welch's 95 % interval. A dead
-    band variant ``X@deadband<d>`` is the same trained policies as ``X``: its difference to ``X`` is
+    seeds, and (other variants) its difference to ``reference`` with Welch's 95 % interval. An acting
+    variant (``X@deadband<d>``, ``X@nomirror``) is the same trained policies as ``X``: its difference to ``X`` is
     also given paired by seed (``minus_X_paired``: mean of the per-seed differences, t interval)."""
     variants: dict[str, dict] = {}
     for name, result in scored.items():
@@ -132,6 +140,8 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--deadbands", default=str(GOAL_DEADBAND_M), help="comma-separated goal dead bands (m) for the LBGP runs")
+    ap.add_argument("--mirror", default="on" if MIRROR_AVERAGE else "off",
+                    help="comma-separated on/off: score every run with and/or without mirror-averaged acting")
     ap.add_argument("--resummarise", action="store_true",
                     help="no scoring: summarise the runs already in --json again (after a change to the summary only)")
     args = ap.parse_args(argv)
@@ -142,16 +152,18 @@ def main(argv: list[str] | None = None) -> dict:
         return result
     scenarios = args.scenarios.split(",")
     deadbands = [float(d) for d in args.deadbands.split(",")]
+    mirrors = [{"on": True, "off": False}.get(m) for m in args.mirror.split(",")]
+    if None in mirrors:
+        ap.error(f"--mirror takes a comma-separated list of on and off, got {args.mirror!r}")
     policies = run_policies(Path(args.runs))
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
-    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None)]
+    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None)]
     for name, path in policies.items():
-        if variant_of(name) == "E2E":
-            jobs.append((name, "e2e", str(path), scenarios, args.episodes, args.seed, None))
-            continue
-        for d in deadbands:
-            jobs.append((deadband_run_name(name, d, GOAL_DEADBAND_M), "lbgp", str(path), scenarios, args.episodes, args.seed, d))
+        e2e = variant_of(name) == "E2E"
+        for d in [None] if e2e else deadbands:
+            for m in mirrors:
+                jobs.append((acting_run_name(name, d, m), "e2e" if e2e else "lbgp", str(path), scenarios, args.episodes, args.seed, d, m))
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")

@@ -44,10 +44,18 @@ def action_from_goal(goal_xy) -> np.ndarray:
     return np.clip(2.0 * (g - lo) / (hi - lo) - 1.0, -1.0, 1.0)
 
 
+def mirror_action(action) -> np.ndarray:
+    """The action's mirror image about the person's heading line (see
+    ``lbgp.sim.observation.mirror``): a goal's y and a velocity command's w change sign; the
+    second number in both forms, since both ranges are symmetric about 0."""
+    a = _check(action)
+    return np.array([a[0], -a[1]])
+
+
 def velocity_from_action(action) -> tuple[float, float]:
     """[-1, 1]^2 -> (v, w) = (a0 * 1 m/s, a1 * 2 rad/s)."""
     a = _check(action)
     return float(a[0] * MAX_V), float(a[1] * MAX_W)
 
 
-__all__ = ["DESIRED_GOAL", "GOAL_X", "GOAL_Y", "MAX_V", "MAX_W", "goal_from_action", "action_from_goal", "velocity_from_action"]
+__all__ = ["DESIRED_GOAL", "GOAL_X", "GOAL_Y", "MAX_V", "MAX_W", "goal_from_action", "action_from_goal", "mirror_action", "velocity_from_action"]

@@ -62,7 +62,7 @@ def cmd_evaluate(args) -> int:
     from lbgp.policies import make_policy
 
     policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon, robot=args.robot, transfer=args.transfer,
-                         goal_deadband=args.goal_deadband)
+                         goal_deadband=args.goal_deadband, mirror_average=False if args.no_mirror else None)
     names = resolve_names(args.scenario)
     recorder = None
     if args.record or args.spawn:
@@ -141,7 +141,8 @@ def cmd_deploy(args) -> int:
     from lbgp.policies import make_policy
     from lbgp.real.deploy import deploy
 
-    policy = make_policy(args.method, args.policy, robot=args.robot, transfer=args.transfer, goal_deadband=args.goal_deadband)
+    policy = make_policy(args.method, args.policy, robot=args.robot, transfer=args.transfer, goal_deadband=args.goal_deadband,
+                         mirror_average=False if args.no_mirror else None)
     print(f"lbgp deploy: {args.method} policy, source {args.source}, sink {args.sink or 'default'}, robot {args.robot}"
           + (f", logging to {args.log}" if args.log else ""), flush=True)
     previous = _stop_on_signals()
@@ -240,6 +241,8 @@ def cmd_experiment(args) -> int:
 
 GOAL_DEADBAND_HELP = ("LBGP: shrink the policy's residual goal this far toward the goal 1.5 m ahead "
                       "(m; default 0.1, docs/training.md; 0: the actor's raw goal)")
+NO_MIRROR_HELP = ("act with the actor's own answer instead of the mean of its answers to the observation and to its mirror "
+                  "image (lbgp, e2e; docs/training.md)")
 DRIVE_MODEL_HELP = ("the planner's model of the robot's drive: none (default: it acts at once), hardware_like, or lbgp sysid's "
                     "JSON; goal methods (lbgp, hc) then plan within its acceleration limits from the state predicted one latency ahead")
 
@@ -333,6 +336,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--spawn", action="store_true", help="also open a live rerun viewer (when one is installed)")
     p.add_argument("--transfer", action="store_true", help="allow a policy file trained on another robot (zero-shot transfer)")
     p.add_argument("--goal-deadband", type=A.nonnegative_float, default=None, metavar="M", help=GOAL_DEADBAND_HELP)
+    p.add_argument("--no-mirror", action="store_true", help=NO_MIRROR_HELP)
     p.add_argument("--dynamics", type=A.dynamics_spec, default=None,
                    help="robot dynamics: nominal (default), hardware_like, or a JSON file (e.g. from lbgp sysid)")
     p.add_argument("--calibration", type=A.calibration_spec, default=None,
@@ -415,6 +419,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--transfer", action="store_true",
                    help="allow a policy file trained on another robot (zero-shot transfer; the shipped Jackal policies always may)")
     p.add_argument("--goal-deadband", type=A.nonnegative_float, default=None, metavar="M", help=GOAL_DEADBAND_HELP)
+    p.add_argument("--no-mirror", action="store_true", help=NO_MIRROR_HELP)
     p.add_argument("--planner-budget-ms", type=A.nonnegative_float, default=2.0,
                    help="anytime SQP budget per planner call (default 2 ms, keeps pose-to-command latency p99 under 5 ms; 0: "
                         "fixed iteration counts as in simulation)")

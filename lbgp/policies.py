@@ -22,21 +22,24 @@ def default_policy_path(method: str = "lbgp", robot: str = "jackal") -> Path:
 
 
 def make_policy(method: str, policy_file=None, hc_distance: float | None = None, hc_horizon: float | None = None,
-                robot: str | None = None, transfer: bool = False, goal_deadband: float | None = None):
+                robot: str | None = None, transfer: bool = False, goal_deadband: float | None = None,
+                mirror_average: bool | None = None):
     """The policy of ``method``: lbgp/e2e load ``policy_file`` (default: the shipped Jackal one),
     hc builds the EKF baseline, scripted asks for a goal 1.5 m ahead.
 
     A policy file for another method is refused; so is one trained on another robot than
     ``robot`` unless ``transfer`` (zero-shot transfer, as in the paper's real-robot experiment).
     The shipped default policies are Jackal-trained and transfer by design. ``goal_deadband`` (m):
-    a residual LBGP policy's dead band around its base goal (default: ``GOAL_DEADBAND_M``)."""
+    a residual LBGP policy's dead band around its base goal (default: ``GOAL_DEADBAND_M``);
+    ``mirror_average``: act mirror-averaged (default: ``MIRROR_AVERAGE``); see lbgp.agent.policy."""
     if method in ("lbgp", "e2e"):
-        from lbgp.agent.policy import GOAL_DEADBAND_M, load_policy
+        from lbgp.agent.policy import GOAL_DEADBAND_M, MIRROR_AVERAGE, load_policy
 
         path = Path(policy_file) if policy_file else default_policy_path(method)
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no such policy file")
-        policy = load_policy(path, goal_deadband=GOAL_DEADBAND_M if goal_deadband is None else goal_deadband)
+        policy = load_policy(path, goal_deadband=GOAL_DEADBAND_M if goal_deadband is None else goal_deadband,
+                             mirror_average=MIRROR_AVERAGE if mirror_average is None else mirror_average)
         if policy.method != method:
             raise ValueError(f"{path} holds a {policy.method} policy, not {method}")
         trained_on = policy.meta.get("robot")

@@ -8,7 +8,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from ablation_scenarios import deadband_run_name, main, summarise, variant_of  # noqa: E402
+from ablation_scenarios import acting_run_name, main, summarise, variant_of  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
@@ -24,10 +24,12 @@ def test_variants_are_summarised_over_their_seeds():
     assert "minus_LBGP" not in out["LBGP"]
 
 
-def test_a_runs_other_goal_dead_bands_are_variants_of_their_own():
-    assert deadband_run_name("LBGP_s1", 0.1, default=0.1) == "LBGP_s1"
-    assert deadband_run_name("LBGP-no-curriculum_s2", 0.0, default=0.1) == "LBGP-no-curriculum@deadband0_s2"
-    assert variant_of(deadband_run_name("LBGP_s1", 0.2, default=0.1)) == "LBGP@deadband0.2"
+def test_a_runs_other_acting_settings_are_variants_of_their_own():
+    assert acting_run_name("LBGP_s1", 0.1, mirror=True) == acting_run_name("LBGP_s1") == "LBGP_s1"  # the defaults
+    assert acting_run_name("LBGP-no-curriculum_s2", 0.0) == "LBGP-no-curriculum@deadband0_s2"
+    assert variant_of(acting_run_name("LBGP_s1", 0.2)) == "LBGP@deadband0.2"
+    assert acting_run_name("E2E_s0", None, mirror=False) == "E2E@nomirror_s0"
+    assert acting_run_name("LBGP_s0", 0.0, mirror=False) == "LBGP@deadband0@nomirror_s0"
 
 
 def test_a_dead_band_variant_is_compared_with_its_own_policies_seed_by_seed():

@@ -72,6 +72,19 @@ def test_evaluate_goal_deadband_option_reaches_the_lbgp_policy(tmp_path):
     assert json.loads(out.read_text())[0]["reward"] == rewards["0.1"]  # 0.1 m is the default
 
 
+def test_evaluate_no_mirror_option_gives_the_actors_own_answer(tmp_path):
+    from lbgp.evaluate import evaluate
+    from lbgp.policies import make_policy
+
+    out = {}
+    for name, extra in (("default", []), ("raw", ["--no-mirror"])):
+        out[name] = tmp_path / f"{name}.json"
+        assert main(["evaluate", "--method", "e2e", "--scenario", "turning_inside", "--episodes", "1", "--json", str(out[name])] + extra) == 0
+    reward = {name: json.loads(path.read_text())[0]["reward"] for name, path in out.items()}
+    (raw,) = evaluate(make_policy("e2e", mirror_average=False), "e2e", ["turning_inside"], episodes=1)
+    assert reward["raw"] == pytest.approx(raw["reward"], abs=1e-3) and reward["raw"] != reward["default"]
+
+
 def test_evaluate_rejects_unknown_scenarios(capsys):
     assert main(["evaluate", "--method", "scripted", "--scenario", "moonwalk"]) == 2
     assert "unknown scenario 'moonwalk'" in capsys.readouterr().err

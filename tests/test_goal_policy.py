@@ -110,7 +110,7 @@ def test_residual_policy_file_round_trips(tmp_path):
     save_policy(tmp_path / "r.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
     obs = np.random.default_rng(1).uniform(-1, 1, obs_lib.SIZE).astype(np.float32)
     expected = actor(torch.from_numpy(obs)[None])[0].detach().numpy()
-    assert np.allclose(load_policy(tmp_path / "r.pt", goal_deadband=0.0).act(obs), expected, atol=1e-6)
+    assert np.allclose(load_policy(tmp_path / "r.pt", goal_deadband=0.0, mirror_average=False).act(obs), expected, atol=1e-6)
     assert not np.allclose(expected, action_from_goal(DESIRED_GOAL))
 
 
@@ -129,12 +129,14 @@ def test_goal_dead_band_shrinks_the_residual_goal_toward_the_goal_ahead(tmp_path
     ahead = np.asarray(DESIRED_GOAL)
     # residual 0.75 m * tanh(b): b = atanh(0.08 / 0.75) gives 8 cm straight to the left
     small = _residual_policy_file(tmp_path, 0.0, math.atanh(0.08 / 0.75))
-    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.0).act(obs)), ahead + [0.0, 0.08], atol=1e-5)
-    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.1).act(obs)), ahead, atol=1e-6)
+    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.0, mirror_average=False).act(obs)), ahead + [0.0, 0.08], atol=1e-5)
+    assert np.allclose(goal_from_action(load_policy(small, goal_deadband=0.1, mirror_average=False).act(obs)), ahead, atol=1e-6)
     # a 0.3 m, 0.4 m residual (length 0.5 m) keeps its direction and loses 0.1 m of its length
     big = _residual_policy_file(tmp_path, math.atanh(0.3 / 0.75), math.atanh(0.4 / 0.75))
-    assert np.allclose(goal_from_action(load_policy(big, goal_deadband=0.1).act(obs)), ahead + [0.24, 0.32], atol=1e-5)
-    assert np.allclose(goal_from_action(load_policy(big).act(obs)), ahead + [0.24, 0.32], atol=1e-5)  # the default: 0.1 m
+    assert np.allclose(goal_from_action(load_policy(big, goal_deadband=0.1, mirror_average=False).act(obs)), ahead + [0.24, 0.32], atol=1e-5)
+    # the defaults: 0.1 m, mirror averaged (a residual to the left whatever the observation cancels
+    # against its mirror image, to the right: 0.3 m straight ahead is left, 0.2 m after the band)
+    assert np.allclose(goal_from_action(load_policy(big).act(obs)), ahead + [0.2, 0.0], atol=1e-5)
     with pytest.raises(ValueError, match="goal_deadband"):
         load_policy(big, goal_deadband=float("nan"))
     with pytest.raises(ValueError, match="goal_deadband"):
@@ -149,6 +151,32 @@ def test_goal_dead_band_leaves_plain_actors_and_e2e_alone(tmp_path):
         with torch.no_grad():
             actor.net[-1].bias.fill_(0.05)
         save_policy(tmp_path / f"{method}.pt", actor, method, "jackal", (8,))
-        policy = load_policy(tmp_path / f"{method}.pt", goal_deadband=0.5)
+        policy = load_policy(tmp_path / f"{method}.pt", goal_deadband=0.5, mirror_average=False)
         assert policy.goal_deadband == 0.0
         assert np.allclose(policy.act(obs), actor(torch.from_numpy(obs)[None])[0].detach().numpy(), atol=1e-6)
+
+
+def test_mirror_averaged_acting_is_exactly_mirror_equivariant_for_every_kind_of_policy(tmp_path):
+    """The default acting: a world and its mirror image get mirrored actions, whatever the actor
+    learned, and the action is the mean of the actor's answer and its mirrored answer to the mirror
+    image; ``mirror_average=False`` is the actor's own answer."""
+    from lbgp.actions import mirror_action
+
+    rng = np.random.default_rng(4)
+    obs = rng.uniform(-1, 1, (5, obs_lib.SIZE)).astype(np.float32)
+    for method, residual in (("lbgp", 0.75), ("lbgp", 0.0), ("e2e", 0.0)):
+        torch.manual_seed(1)
+        actor = Actor(obs_lib.SIZE, 2, (16,), residual_scale=residual, base=action_from_goal(DESIRED_GOAL) if residual else None)
+        with torch.no_grad():
+            for p in actor.net.parameters():
+                p.add_(0.3 * torch.randn_like(p))  # an asymmetric actor (the residual one starts at zero)
+        save_policy(tmp_path / "p.pt", actor, method, "jackal", (16,), residual_scale=residual)
+        averaged = load_policy(tmp_path / "p.pt", goal_deadband=0.0)
+        raw = load_policy(tmp_path / "p.pt", goal_deadband=0.0, mirror_average=False)
+        assert averaged.mirror_average and not raw.mirror_average
+        for o in obs:
+            own, of_mirror = raw.act(o), raw.act(obs_lib.mirror(o))
+            assert np.abs(own - mirror_action(of_mirror)).max() > 1e-3  # the actor itself is not symmetric
+            np.testing.assert_allclose(averaged.act(o), 0.5 * (own + mirror_action(of_mirror)), atol=1e-6)
+            np.testing.assert_allclose(averaged.act(obs_lib.mirror(o)), mirror_action(averaged.act(o)), atol=1e-6)
+            np.testing.assert_allclose(raw.act(o), actor(torch.from_numpy(o)[None])[0].detach().numpy(), atol=1e-6)

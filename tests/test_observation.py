@@ -65,3 +65,29 @@ def test_non_finite_frames_are_rejected():
     stack = obs.ObservationStack()
     with pytest.raises(ValueError, match="non-finite"):
         stack.push([0.0, float("nan"), 0.0], [0.0, 0.0, 0.0])
+
+
+def test_mirror_is_the_observation_of_the_world_reflected_about_any_line():
+    """Reflect a random walk of both poses about a line through the world (x -> x, y -> -y after
+    moving and turning the world): the observation of the reflected world is mirror() of the
+    original's, frame by frame; the wrong sign on x, y or phi in any frame would break it."""
+    rng = np.random.default_rng(3)
+    robots = np.cumsum(rng.normal(0, 0.3, (12, 3)), axis=0) + [1.5, 0.2, 0.1]
+    persons = np.cumsum(rng.normal(0, 0.3, (12, 3)), axis=0)
+    c, s, shift = math.cos(0.8), math.sin(0.8), np.array([2.0, -1.0])
+
+    def reflect(pose):  # rotate the world by 0.8 rad and move it, then reflect it about its x axis
+        x, y = c * pose[0] - s * pose[1] + shift[0], s * pose[0] + c * pose[1] + shift[1]
+        return np.array([x, -y, -(pose[2] + 0.8)])
+
+    plain, mirrored = obs.ObservationStack(), obs.ObservationStack()
+    for r, p in zip(robots, persons):
+        plain.push(r, p)
+        mirrored.push(reflect(r), reflect(p))
+    a, b = plain.vector(), mirrored.vector()
+    assert not np.allclose(a, obs.mirror(a), atol=1e-3)  # the walk is not symmetric by itself
+    np.testing.assert_allclose(b, obs.mirror(a), atol=1e-5)
+    np.testing.assert_array_equal(obs.mirror(obs.mirror(a)), a)
+    np.testing.assert_array_equal(obs.mirror(np.stack([a, b])), np.stack([obs.mirror(a), obs.mirror(b)]))
+    with pytest.raises(ValueError, match="57 numbers"):
+        obs.mirror(a[:-3])

@@ -12,6 +12,14 @@ a residual smaller than the band gives exactly the goal ahead and a larger one k
 Measured over the ablation's three LBGP seeds on the paper scenarios (docs/training.md): the small
 residuals are mostly the observation noise passed through, and the goal they jitter costs reward
 where the person walks straight.
+
+Every policy acts mirror-averaged (``MIRROR_AVERAGE``): the task is symmetric about the person's
+heading line (``lbgp.sim.observation.mirror``), so the actor is asked about the observation and its
+mirror image, and the action is the mean of its answer and the mirrored answer to the mirror image.
+The result is exactly mirror-equivariant (a world and its mirror image get mirrored actions, so a
+left-right bias the actor learned cancels) and averages two estimates of the same action (less of
+the noise the actor passes through). Measured on the paper scenarios over the ablation's seeds
+(docs/training.md); ``mirror_average=False`` gives the actor's own answer.
 """
 
 from __future__ import annotations
@@ -19,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from lbgp.actions import action_from_goal, goal_from_action
+from lbgp.actions import action_from_goal, goal_from_action, mirror_action
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.agent.networks import Actor
 from lbgp.sim import observation as obs_lib
@@ -28,6 +36,7 @@ FORMAT = "lbgp-policy"
 VERSION = 2  # 2: input standardisation buffers and the residual goal form (version 1 files still load)
 READABLE = (1, 2)
 GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
+MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
 
 def shrink_residual(action, base, deadband_m: float) -> np.ndarray:
@@ -46,7 +55,8 @@ def shrink_residual(action, base, deadband_m: float) -> np.ndarray:
 class Policy:
     """A deterministic actor: ``act(observation) -> action``."""
 
-    def __init__(self, actor: Actor, method: str, meta: dict, goal_deadband: float = GOAL_DEADBAND_M):
+    def __init__(self, actor: Actor, method: str, meta: dict, goal_deadband: float = GOAL_DEADBAND_M,
+                 mirror_average: bool = MIRROR_AVERAGE):
         if not (np.isfinite(goal_deadband) and goal_deadband >= 0.0):
             raise ValueError(f"goal_deadband must be a finite distance >= 0 m, got {goal_deadband!r}")
         self.actor = actor.eval()
@@ -55,6 +65,7 @@ class Policy:
         self.meta = meta
         # only a residual goal policy has a base goal to shrink toward
         self.goal_deadband = float(goal_deadband) if self.actor.residual_scale > 0 and self.control == "goal" else 0.0
+        self.mirror_average = bool(mirror_average)
 
     def reset(self) -> None:
         pass
@@ -64,7 +75,11 @@ class Policy:
         obs = np.asarray(observation, np.float32)
         if obs.shape != (obs_lib.SIZE,):
             raise ValueError(f"policy expects an observation of shape ({obs_lib.SIZE},), got {obs.shape}")
-        action = self.actor(torch.from_numpy(obs)[None])[0].numpy()
+        if self.mirror_average:
+            own, of_mirror = self.actor(torch.from_numpy(np.stack([obs, obs_lib.mirror(obs)]))).numpy()
+            action = (0.5 * (own + mirror_action(of_mirror))).astype(np.float32)
+        else:
+            action = self.actor(torch.from_numpy(obs)[None])[0].numpy()
         if self.goal_deadband > 0.0:
             return shrink_residual(action, self.actor.base.numpy(), self.goal_deadband)
         return action
@@ -89,9 +104,10 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
     )
 
 
-def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M) -> Policy:
+def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bool = MIRROR_AVERAGE) -> Policy:
     """Load a policy file; a corrupt, foreign or mismatched file raises a ValueError saying why.
-    ``goal_deadband``: see the module's docstring (ignored by e2e and plain-actor policies)."""
+    ``goal_deadband`` (ignored by e2e and plain-actor policies), ``mirror_average``: see the
+    module's docstring."""
     data = load_checked(path, FORMAT)
     if data.get("version") not in READABLE:
         raise ValueError(f"{path}: policy file version {data.get('version')} is not supported (expected one of {READABLE})")
@@ -119,4 +135,4 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M) -> Policy:
         raise ValueError(f"{path}: actor weights do not match the stored sizes, expected {expected} ({reason})") from None
     if int(data["action_size"]) != 2:
         raise ValueError(f"{path}: policy has {data['action_size']} outputs, expected {expected}")
-    return Policy(actor, data["method"], meta, goal_deadband=goal_deadband)
+    return Policy(actor, data["method"], meta, goal_deadband=goal_deadband, mirror_average=mirror_average)

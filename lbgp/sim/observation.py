@@ -14,6 +14,11 @@ the start of an episode the history is filled with copies of the first frame.
 
 Optional Gaussian noise (std ``noise_std`` = (metres, radians)) is added to the relative states
 before scaling; it is on in training levels and off in evaluation scenarios by default.
+
+``mirror(obs)`` is the observation of the mirror-image world, reflected about the person's heading
+line (y -> -y, phi -> -phi in every frame): the task is symmetric under it (the reward depends on D
+and |alpha|, the training levels walk both turn directions), which a policy can use when it acts
+(``lbgp.agent.policy``).
 """
 
 from __future__ import annotations
@@ -99,6 +104,19 @@ _INV_SCALE = 1.0 / np.array([POSITION_SCALE, POSITION_SCALE, ANGLE_SCALE])
 def scale(raw: np.ndarray) -> np.ndarray:
     raw = np.asarray(raw, dtype=float).reshape(-1, 3) * _INV_SCALE
     return np.clip(raw.ravel(), -1.0, 1.0).astype(np.float32)
+
+
+_MIRROR = np.tile(np.array([1.0, -1.0, -1.0], dtype=np.float32), SIZE // 3)
+
+
+def mirror(obs: np.ndarray) -> np.ndarray:
+    """The observation of the world reflected about the person's heading line: every relative
+    state's y and phi change sign (the scaling and its clipping to [-1, 1] are symmetric, so this
+    is exact on scaled observations). Works on one observation or a batch (last axis: the 57)."""
+    obs = np.asarray(obs, dtype=np.float32)
+    if obs.shape[-1:] != (SIZE,):
+        raise ValueError(f"an observation has {SIZE} numbers, got shape {obs.shape}")
+    return obs * _MIRROR
 
 
 def unscale(obs: np.ndarray) -> np.ndarray:

@@ -19,7 +19,10 @@ mirror image, and the action is the mean of its answer and the mirrored answer t
 The result is exactly mirror-equivariant (a world and its mirror image get mirrored actions, so a
 left-right bias the actor learned cancels) and averages two estimates of the same action (less of
 the noise the actor passes through). Measured on the paper scenarios over the ablation's seeds
-(docs/training.md); ``mirror_average=False`` gives the actor's own answer.
+(docs/training.md); ``mirror_average=False`` gives the actor's own answer. What it costs: from
+straight behind the person, passing means choosing a side, which an equivariant policy cannot
+prefer (its lateral goal is zero in a state that is its own mirror image); the real-world
+protocol's behind starts lose what the actor's side preference had won there (docs/training.md).
 """
 
 from __future__ import annotations

@@ -22,7 +22,8 @@ the noise the actor passes through). Measured on the paper scenarios over the ab
 (docs/training.md); ``mirror_average=False`` gives the actor's own answer. What it costs: from
 straight behind the person, passing means choosing a side, which an equivariant policy cannot
 prefer (its lateral goal is zero in a state that is its own mirror image); the real-world
-protocol's behind starts lose what the actor's side preference had won there (docs/training.md).
+protocol's behind starts lose what the shipped actor's side preference had won there
+(docs/training.md).
 """
 
 from __future__ import annotations

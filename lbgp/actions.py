@@ -52,10 +52,18 @@ def mirror_action(action) -> np.ndarray:
     return np.array([a[0], -a[1]])
 
 
+def mirror_actions(actions: np.ndarray) -> np.ndarray:
+    """``mirror_action`` for a batch (N, 2), dtype kept (training data, checked where it was made)."""
+    actions = np.asarray(actions)
+    if actions.ndim != 2 or actions.shape[1] != 2:
+        raise ValueError(f"a batch of actions has shape (N, 2), got {actions.shape}")
+    return actions * np.array([1, -1], dtype=actions.dtype)
+
+
 def velocity_from_action(action) -> tuple[float, float]:
     """[-1, 1]^2 -> (v, w) = (a0 * 1 m/s, a1 * 2 rad/s)."""
     a = _check(action)
     return float(a[0] * MAX_V), float(a[1] * MAX_W)
 
 
-__all__ = ["DESIRED_GOAL", "GOAL_X", "GOAL_Y", "MAX_V", "MAX_W", "goal_from_action", "action_from_goal", "mirror_action", "velocity_from_action"]
+__all__ = ["DESIRED_GOAL", "GOAL_X", "GOAL_Y", "MAX_V", "MAX_W", "goal_from_action", "action_from_goal", "mirror_action", "mirror_actions", "velocity_from_action"]

@@ -100,7 +100,8 @@ def cmd_train(args) -> int:
             method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
         )
-        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "max_updates_per_step": args.updates_per_step}
+        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "max_updates_per_step": args.updates_per_step,
+                 "mirror_augment": True if args.mirror_augment else None}
         if args.randomize:
             from lbgp.dynamics import load_randomization
 
@@ -359,6 +360,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the learner's updates per collected env step at most (default 2; --paper: 1)")
     p.add_argument("--randomize", type=A.randomize_spec, default=None, metavar="PRESET|FILE",
                    help="domain randomisation per episode: a preset (default, none) or a JSON file of ranges (docs/simulation.md)")
+    p.add_argument("--mirror-augment", action="store_true",
+                   help="also store every transition's mirror image (about the person's heading line) in the replay")
     p.add_argument("--paper", action="store_true",
                    help="the paper's plain D4PG configuration: tanh actor on raw inputs, white noise 0.3, uniform spawns, no goal prior")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],

@@ -100,3 +100,10 @@ def test_train_prior_weight_option_reaches_the_run_config_and_bad_values_are_ref
     default = tmp_path / "default"
     assert main(["train", "--steps", "40", "--backend", "inline", "--out", str(default)]) == 0
     assert json.loads((default / "config.json").read_text())["prior_weight"] == 1.0
+    assert json.loads((default / "config.json").read_text())["mirror_augment"] is False
+
+
+def test_train_mirror_augment_flag_reaches_the_run_config(tmp_path):
+    run = tmp_path / "run"
+    assert main(["train", "--mirror-augment", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    assert json.loads((run / "config.json").read_text())["mirror_augment"] is True

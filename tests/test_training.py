@@ -157,3 +157,38 @@ def test_ray_backend_trains_where_ray_is_installed(tmp_path):
     summary = train(cfg, tmp_path / "run", backend="ray", progress=False)
     assert summary["env_steps"] >= 300 and summary["learner_updates"] > 0
     assert load_policy(tmp_path / "run" / "policy.pt").act(np.zeros(57, np.float32)).shape == (2,)
+
+
+
+def _replay_rows(replay) -> np.ndarray:
+    n = len(replay)
+    return np.hstack([replay.obs[:n], replay.action[:n], replay.ret[:n, None], replay.discount[:n, None], replay.next_obs[:n]])
+
+
+def test_mirror_augment_stores_each_transition_and_its_mirror_image(tmp_path):
+    """With ``mirror_augment`` the replay holds what the same seeded run collects without it, plus
+    each of those transitions reflected about the person's heading line (y and phi of every relative
+    state negated, the goal's lateral part negated, the same n-step return and discount)."""
+    common = {**TINY, "total_steps": 60, "min_replay": 10_000}  # no learning: both runs act alike
+    plain = Trainer(D4PGConfig(**common, seed=1), tmp_path / "plain", backend="inline", progress=False)
+    plain.run()
+    augmented = Trainer(D4PGConfig(**common, seed=1, mirror_augment=True), tmp_path / "aug", backend="inline", progress=False)
+    augmented.run()
+    rows = _replay_rows(plain.replay)
+    assert len(rows) > 0 and len(augmented.replay) == 2 * len(rows)
+    obs, act, nxt = rows[:, :57].copy(), rows[:, 57:59].copy(), rows[:, 61:].copy()
+    for frame in (obs, nxt):
+        frame[:, 1::3] *= -1.0
+        frame[:, 2::3] *= -1.0
+    act[:, 1] *= -1.0
+    reflected = np.hstack([obs, act, rows[:, 59:61], nxt])
+    assert not np.array_equal(reflected, rows)  # the episodes were not their own mirror images
+    expected = np.vstack([rows, reflected])
+    got = _replay_rows(augmented.replay)
+
+    def by_rows(a):
+        return a[np.lexsort(a.T[::-1])]
+
+    np.testing.assert_array_equal(by_rows(got), by_rows(expected))
+    assert json.loads((tmp_path / "aug" / "config.json").read_text())["mirror_augment"] is True
+    assert json.loads((tmp_path / "plain" / "config.json").read_text())["mirror_augment"] is False

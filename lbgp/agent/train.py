@@ -35,7 +35,7 @@ from lbgp.agent.config import D4PGConfig
 from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
-from lbgp.agent.replay import ReplayBuffer
+from lbgp.agent.replay import ReplayBuffer, mirrored
 from lbgp.sim import observation as obs_lib
 
 CHECKPOINT_FORMAT = "lbgp-checkpoint"
@@ -200,6 +200,8 @@ class Trainer:
         _, actor_id, exploring, level, ret, steps, batch = msg
         if len(batch[0]):
             self.replay.add_batch(*batch)
+            if self.cfg.mirror_augment:
+                self.replay.add_batch(*mirrored(batch))
         self.env_steps += steps
         self.episodes += 1
         if not exploring:

@@ -19,6 +19,11 @@ are variants ``<variant>@deadband<d>``): the ablation of that choice over the sa
 acting (lbgp.agent.policy.MIRROR_AVERAGE; the default keeps the plain name, the other is
 ``<variant>@nomirror`` or ``<variant>@mirror``). The two choices combine: ``LBGP@deadband0@nomirror``
 is the actor's own raw answer.
+
+``--runs`` takes several folders and ``--variants`` picks variants, so that runs of another training
+choice kept elsewhere are compared with the ablation's LBGP runs on the same episodes, e.g. mirror
+augmentation in training (docs/training.md):
+``--runs results/ablation_runs,results/mirror_augment_runs --variants LBGP,LBGP-mirror-augment``.
 """
 
 from __future__ import annotations
@@ -41,9 +46,18 @@ from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
 
-def run_policies(runs_dir: Path) -> dict[str, Path]:
-    """``<variant>_s<seed>`` -> its policy file, for every archived run that has one."""
-    return {p.parent.name: p for p in sorted(runs_dir.glob("*/policy.pt"))}
+def run_policies(runs_dirs, variants: list[str] | None = None) -> dict[str, Path]:
+    """``<variant>_s<seed>`` -> its policy file, for every archived run that has one, in one folder
+    or several (a run name found twice is an error); only the ``variants`` named, if given."""
+    found: dict[str, Path] = {}
+    for runs_dir in [runs_dirs] if isinstance(runs_dirs, (str, Path)) else runs_dirs:
+        for p in sorted(Path(runs_dir).glob("*/policy.pt")):
+            if variants is not None and variant_of(p.parent.name) not in variants:
+                continue
+            if p.parent.name in found:
+                raise ValueError(f"run {p.parent.name} is in two folders: {found[p.parent.name].parent.parent} and {runs_dir}")
+            found[p.parent.name] = p
+    return found
 
 
 def variant_of(run: str) -> str:
@@ -134,7 +148,9 @@ def paired_difference(sums: dict[str, float], base_sums: dict[str, float]) -> di
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", default="results/ablation_scenarios.json")
-    ap.add_argument("--runs", default="results/ablation_runs", help="folder of the ablation's runs (<variant>_s<seed>/policy.pt)")
+    ap.add_argument("--runs", default="results/ablation_runs",
+                    help="comma-separated folders of training runs (<variant>_s<seed>/policy.pt)")
+    ap.add_argument("--variants", help="comma-separated variants to score (default: every run found)")
     ap.add_argument("--scenarios", default=",".join(scenario_names()), help="comma-separated (default: the 9 paper scenarios)")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
@@ -155,7 +171,7 @@ def main(argv: list[str] | None = None) -> dict:
     mirrors = [{"on": True, "off": False}.get(m) for m in args.mirror.split(",")]
     if None in mirrors:
         ap.error(f"--mirror takes a comma-separated list of on and off, got {args.mirror!r}")
-    policies = run_policies(Path(args.runs))
+    policies = run_policies(args.runs.split(","), args.variants.split(",") if args.variants else None)
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None)]

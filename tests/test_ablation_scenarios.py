@@ -67,3 +67,22 @@ def test_each_runs_policy_faces_the_noisy_episodes_of_the_sim_table(tmp_path):
     assert result["runs"]["E2E_s0"]["method"] == "e2e" and result["hc"]["method"] == "hc"
     assert result["runs"]["E2E_s0"]["sum"] != result["runs"]["LBGP_s0"]["sum"] != result["hc"]["sum"]
     assert (tmp_path / "out.json").is_file()
+
+
+def test_runs_from_several_folders_and_chosen_variants(tmp_path):
+    from ablation_scenarios import run_policies
+
+    a, b = tmp_path / "ablation_runs", tmp_path / "other_runs"
+    for folder, run in ((a, "LBGP_s0"), (a, "E2E_s0"), (b, "LBGP-mirror-augment_s0"), (b, "LBGP-mirror-augment_s1")):
+        (folder / run).mkdir(parents=True)
+        (folder / run / "policy.pt").write_bytes(b"")
+    (a / "LBGP_s1").mkdir()  # a run without a policy file is not a run to score
+    assert sorted(run_policies([a, b])) == ["E2E_s0", "LBGP-mirror-augment_s0", "LBGP-mirror-augment_s1", "LBGP_s0"]
+    chosen = run_policies([a, b], ["LBGP", "LBGP-mirror-augment"])
+    assert sorted(chosen) == ["LBGP-mirror-augment_s0", "LBGP-mirror-augment_s1", "LBGP_s0"]
+    assert chosen["LBGP-mirror-augment_s1"] == b / "LBGP-mirror-augment_s1" / "policy.pt"
+    assert sorted(run_policies(a)) == ["E2E_s0", "LBGP_s0"]  # one folder, as before
+    (b / "LBGP_s0").mkdir()
+    (b / "LBGP_s0" / "policy.pt").write_bytes(b"")
+    with pytest.raises(ValueError, match="LBGP_s0 is in two folders"):
+        run_policies([a, b])

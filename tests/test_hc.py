@@ -73,3 +73,22 @@ def test_hc_goal_is_ahead_of_the_predicted_person():
     goal = HCPolicy(horizon=1.0).goal(stack.vector())
     assert goal[1] > 0.5  # a left turn puts the goal to the person's left
     assert math.isfinite(goal[0])
+
+
+def test_ctrv_jacobian_matches_finite_differences_on_both_branches():
+    from lbgp.baselines.ekf import ctrv, ctrv_jacobian
+
+    rng = np.random.default_rng(0)
+    states = [np.array([*rng.normal(0, 2, 2), rng.uniform(-np.pi, np.pi), rng.uniform(0, 2), rng.uniform(-1.5, 1.5)]) for _ in range(50)]
+    states += [np.array([0.3, -0.2, 0.7, 1.2, 0.0]), np.array([0.0, 0.0, -2.0, 0.8, 5e-7])]  # straight branch
+    for state in states:
+        for dt in (0.2, 1.0):
+            numeric = np.zeros((5, 5))
+            for i in range(5):
+                d = np.zeros(5)
+                d[i] = 1e-5
+                if i == 4 and abs(state[4]) <= 1e-6:  # finite differences across the branch: use the turning side
+                    numeric[:, i] = (ctrv(state + 2 * d, dt) - ctrv(state + d, dt)) / 1e-5
+                else:
+                    numeric[:, i] = (ctrv(state + d, dt) - ctrv(state - d, dt)) / 2e-5
+            np.testing.assert_allclose(ctrv_jacobian(state, dt), numeric, atol=2e-5 * max(1.0, dt * state[3]) * 10)

@@ -26,13 +26,20 @@ def ctrv(state: np.ndarray, dt: float) -> np.ndarray:
 
 
 def ctrv_jacobian(state: np.ndarray, dt: float) -> np.ndarray:
-    """d ctrv / d state, by central differences (5x5, cheap and exact enough for filtering)."""
-    J = np.zeros((5, 5))
-    for i in range(5):
-        h = 1e-6 * max(1.0, abs(state[i]))
-        d = np.zeros(5)
-        d[i] = h
-        J[:, i] = (ctrv(state + d, dt) - ctrv(state - d, dt)) / (2 * h)
+    """d ctrv / d state (5x5), analytic; on the straight branch (|omega| <= 1e-6) the omega column
+    is the turning branch's limit at omega -> 0."""
+    x, y, th, v, w = state
+    s0, c0 = math.sin(th), math.cos(th)
+    J = np.eye(5)
+    J[2, 4] = dt
+    if abs(w) > 1e-6:
+        s1, c1 = math.sin(th + w * dt), math.cos(th + w * dt)
+        ds, dc = s1 - s0, c1 - c0
+        J[0, 2], J[0, 3], J[0, 4] = v / w * dc, ds / w, v / w * dt * c1 - v / w**2 * ds
+        J[1, 2], J[1, 3], J[1, 4] = v / w * ds, -dc / w, v / w * dt * s1 + v / w**2 * dc
+    else:
+        J[0, 2], J[0, 3], J[0, 4] = -v * dt * s0, dt * c0, -0.5 * v * dt**2 * s0
+        J[1, 2], J[1, 3], J[1, 4] = v * dt * c0, dt * s0, 0.5 * v * dt**2 * c0
     return J
 
 

@@ -159,7 +159,6 @@ def test_ray_backend_trains_where_ray_is_installed(tmp_path):
     assert load_policy(tmp_path / "run" / "policy.pt").act(np.zeros(57, np.float32)).shape == (2,)
 
 
-
 def _replay_rows(replay) -> np.ndarray:
     n = len(replay)
     return np.hstack([replay.obs[:n], replay.action[:n], replay.ret[:n, None], replay.discount[:n, None], replay.next_obs[:n]])

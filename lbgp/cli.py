@@ -279,7 +279,7 @@ def cmd_sysid(args) -> int:
     summary = result.summary()
     print(f"lbgp sysid: {args.log_file}, robot {args.robot}, {summary['duration_s']} s of data")
     for key, value in summary.items():
-        print(f"  {key:<18}{value}")
+        print(f"  {key:<18}{'not limiting' if value is None else value}")
     if args.out:
         save_dynamics(Path(args.out), result.dynamics, extra={"fit": summary, "log": str(args.log_file), "robot": args.robot})
         print(f"dynamics written to {args.out} (simulate this robot: --dynamics {args.out}; calibrate commands for it: --calibration {args.out})")

@@ -5,12 +5,15 @@ limits, gains) from a deploy log's commands and motion-capture poses.
     lbgp sysid excite.mcap --robot turtlebot2 --out dynamics.json [--png fit.png]
 
 The model is the simulator's own drive train (``lbgp.drive_train.DriveTrain``: command latency, the
-firmware's acceleration limiter, a first-order lag) followed by gains on v and w (what the wheels
-and the floor make of the setpoint: servo gain, skid-steer slip). The measured body velocity comes
-from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative). The
-latency is searched on a grid up to 0.3 s: every 30 ms with the other parameters at their start
-values, then every 10 ms within 60 ms of the best; for each of those, scipy's ``least_squares`` fits
-the other five parameters, and the latency with the smallest residual wins.
+firmware's acceleration limiter, a first-order lag), then the simulated base's response to its wheel
+setpoints (``SIM_BASE_RESPONSE``: its body runs ahead of a smooth setpoint), then gains on v and w
+(what the wheels and the floor make of the setpoint: servo gain, skid-steer slip). So the fitted
+parameters are the ones that make the simulator reproduce the log. The measured body velocity comes
+from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative), and the
+model's velocity goes through the very same differentiator (``as_measured``). The latency is
+searched on a grid up to 0.3 s: every 30 ms with the other parameters at their start values, then
+every 10 ms within 60 ms of the best; for each of those, scipy's ``least_squares`` fits the other
+five parameters; from the best, all six are refined together with the latency continuous.
 """
 
 from __future__ import annotations
@@ -49,11 +52,16 @@ class SysidResult:
     def summary(self) -> dict:
         return {
             "latency_s": round(self.latency, 4), "time_constant_s": round(self.time_constant, 4),
-            "max_linear_accel": round(self.max_linear_accel, 3), "max_angular_accel": round(self.max_angular_accel, 3),
+            # None: not limiting at the rates the log commanded (JSON has no infinity)
+            "max_linear_accel": _rounded_or_none(self.max_linear_accel, 3), "max_angular_accel": _rounded_or_none(self.max_angular_accel, 3),
             "gain_v": round(self.gain_v, 3), "gain_w": round(self.gain_w, 3),
             "rms_v": round(self.rms_v, 4), "rms_w": round(self.rms_w, 4),
             "duration_s": round(self.duration, 2), "samples": self.samples,
         }
+
+
+def _rounded_or_none(value: float, digits: int):
+    return None if math.isinf(value) else round(value, digits)
 
 
 def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -69,21 +77,111 @@ def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     return t_cmd, u, t_pose, p
 
 
-def measured_velocity(t_pose: np.ndarray, poses: np.ndarray, dt: float = VELOCITY_GRID) -> tuple[np.ndarray, np.ndarray]:
-    """(grid times, (v, w) per time): body velocity from poses, on a uniform grid."""
+def _grid(t_pose: np.ndarray, dt: float = VELOCITY_GRID) -> np.ndarray:
+    return np.arange(t_pose[0], t_pose[-1], dt)
+
+
+def _rate(t: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """d/dt of samples ``values`` at times ``t``: linearly interpolated onto the uniform ``grid``,
+    then a Savitzky-Golay derivative over ~0.2 s. The one differentiator of the measurement and of
+    the model (which is put through it too, so that both see the same smoothing and phase)."""
     from scipy.signal import savgol_filter
 
+    dt = float(grid[1] - grid[0])
+    window = max(5, int(round(0.2 / dt)) | 1)  # ~0.2 s, odd
+    return savgol_filter(np.interp(grid, t, values), window, 2, deriv=1, delta=dt)
+
+
+def _unique_times(t_pose: np.ndarray, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     order = np.argsort(t_pose)
     t, p = t_pose[order], poses[order]
     keep = np.concatenate([[True], np.diff(t) > 1e-6])
-    t, p = t[keep], p[keep]
-    grid = np.arange(t[0], t[-1], dt)
+    return t[keep], p[keep]
+
+
+def measured_velocity(t_pose: np.ndarray, poses: np.ndarray, dt: float = VELOCITY_GRID) -> tuple[np.ndarray, np.ndarray]:
+    """(grid times, (v, w) per time): body velocity from poses, on a uniform grid."""
+    t, p = _unique_times(t_pose, poses)
+    grid = _grid(t, dt)
     yaw = np.unwrap(p[:, 2])
-    x, y, yw = (np.interp(grid, t, c) for c in (p[:, 0], p[:, 1], yaw))
-    window = max(5, int(round(0.2 / dt)) | 1)  # ~0.2 s, odd
-    dx, dy, dyaw = (savgol_filter(c, window, 2, deriv=1, delta=dt) for c in (x, y, yw))
+    dx, dy, dyaw = (_rate(t, c, grid) for c in (p[:, 0], p[:, 1], yaw))
+    yw = np.interp(grid, t, yaw)
     v = dx * np.cos(yw) + dy * np.sin(yw)
     return grid, np.stack([v, dyaw], axis=1)
+
+
+def as_measured(t_model: np.ndarray, velocity: np.ndarray, t_pose: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """What ``measured_velocity`` makes of a body moving with ``velocity`` ((v, w) held over each
+    step of the uniform ``t_model``): distance travelled and heading, sampled at the log's pose
+    times, then the same differentiator. (The log holds one pose per control tick, 10 Hz: its
+    interpolation and smoothing spread a velocity step over ~0.3 s, centred, so a model compared
+    with the raw measurement would have to lead it.)"""
+    dt = float(t_model[1] - t_model[0])
+    travelled = np.concatenate([np.zeros((1, 2)), np.cumsum(velocity * dt, axis=0)])  # at t_model[0] + k dt
+    t_edges = t_model[0] - dt + dt * np.arange(len(travelled))  # velocity[i] acts over (t_model[i] - dt, t_model[i]]
+    return np.stack([_rate(t_pose, np.interp(t_pose, t_edges, travelled[:, i]), grid) for i in (0, 1)], axis=1)
+
+
+# The simulated bases do not follow a smooth wheel setpoint exactly: the body's velocity runs ahead
+# of it (docs/simulation.md), like a lead-lag (1 + lead s) / (1 + lag s) per channel (v, w).
+# Measured by ``measure_base_response`` (seconds; tests/test_sysid.py re-measures them).
+SIM_BASE_RESPONSE: dict[str, tuple[tuple[float, float], tuple[float, float]]] = {
+    "turtlebot2": ((0.137, 0.020), (0.155, 0.031)),
+    "jackal": ((0.100, 0.061), (0.100, 0.052)),
+}
+
+
+def lead_lag(signal: np.ndarray, lead: float, lag: float, dt: float) -> np.ndarray:
+    """(1 + lead s) / (1 + lag s) applied to a signal sampled every ``dt`` (bilinear transform), from rest."""
+    from scipy.signal import lfilter
+
+    a = 2.0 / dt
+    a0 = 1.0 + lag * a
+    return lfilter([(1.0 + lead * a) / a0, (1.0 - lead * a) / a0], [1.0, (1.0 - lag * a) / a0], signal, axis=0)
+
+
+def base_response(setpoints: np.ndarray, robot: str, dt: float) -> np.ndarray:
+    """The simulated base's body velocity for wheel setpoints (v, w) sampled every ``dt``, before its gains."""
+    (lead_v, lag_v), (lead_w, lag_w) = SIM_BASE_RESPONSE[robot]
+    return np.stack([lead_lag(setpoints[:, 0], lead_v, lag_v, dt), lead_lag(setpoints[:, 1], lead_w, lag_w, dt)], axis=1)
+
+
+def measure_base_response(robot: str, time_constants=(0.05, 0.12, 0.2), seed: int = 0) -> tuple[tuple[float, float], ...]:
+    """Re-measure ``SIM_BASE_RESPONSE`` for a robot: play the excitation (``excitation_schedule``,
+    ramped like the deploy loop's acceleration clamp, one command per 0.1 s tick) to the simulated
+    base with nominal dynamics but for a lag of each of ``time_constants``, record the wheel
+    setpoints and the true body velocity every physics step, and fit a gain times a lead-lag per
+    channel by least squares. Returns ((lead_v, lag_v), (lead_w, lag_w)) in seconds."""
+    from scipy.optimize import least_squares
+
+    from lbgp.planner import planner_config_for
+    from lbgp.real.sim_world import SimWorld
+
+    limits = planner_config_for(robot)
+    schedule = np.repeat(excitation_schedule(limits.max_vel_x, limits.max_vel_theta), 2, axis=0)  # 0.2 s -> 0.1 s ticks
+    step_limit = np.array([limits.acc_lim_x, limits.acc_lim_theta]) * 0.1
+    runs = []
+    for tau in time_constants:
+        world = SimWorld("standing_person", robot=robot, seed=seed, dynamics=nominal(robot).replace(time_constant=tau))
+        physics = world.physics
+        command, rows = np.zeros(2), []
+        for target in schedule:
+            command = command + np.clip(target - command, -step_limit, step_limit)
+            world.set_command(*command)
+            for _ in range(int(round(0.1 / physics.timestep()))):
+                physics.step_physics(1)
+                rows.append((*physics.drivetrain.output, *physics.robot_velocity()))
+        runs.append(np.array(rows))
+    dt = float(physics.timestep())
+    out = []
+    for i in (0, 1):
+        def residual(theta):
+            gain, lead, lag = theta
+            return np.concatenate([gain * lead_lag(r[:, i], lead, lag, dt) - r[:, 2 + i] for r in runs])
+
+        sol = least_squares(residual, [1.0, 0.05, 0.01], bounds=([0.3, 0.0, 0.001], [2.0, 0.5, 0.5]))
+        out.append((round(float(sol.x[1]), 3), round(float(sol.x[2]), 3)))
+    return tuple(out)
 
 
 def _check_log(t_cmd, u, t_pose, p) -> None:
@@ -106,19 +204,23 @@ def fit(log: dict, robot: str) -> SysidResult:
 
     t_cmd, u, t_pose, p = log_series(log)
     _check_log(t_cmd, u, t_pose, p)
+    t_pose, p = _unique_times(t_pose, p)
     grid, measured = measured_velocity(t_pose, p)
-    inside = (grid >= t_cmd[0] + 0.3) & (grid <= t_cmd[-1])  # the first samples: filter edge
-    grid, measured = grid[inside], measured[inside]
-    scale = np.array([max(np.std(measured[:, 0]), 0.02), max(np.std(measured[:, 1]), 0.05)])
+    t_model = np.arange(grid[0], grid[-1] + MODEL_DT, MODEL_DT)
+    inside = (grid >= t_cmd[0] + 0.3) & (grid <= t_cmd[-1]) & (grid >= t_pose[0] + 0.3) & (grid <= t_pose[-1] - 0.3)  # filter edges
+    scale = np.array([max(np.std(measured[inside, 0]), 0.02), max(np.std(measured[inside, 1]), 0.05)])
     base = nominal(robot)
 
     def model(theta, latency):
         tau, a_v, a_w, k_v, k_w = theta
         dyn = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w, latency_jitter=0.0)
-        return simulate_setpoints(dyn, t_cmd, u, grid, MODEL_DT) * np.array([k_v, k_w])
+        velocity = base_response(simulate_setpoints(dyn, t_cmd, u, t_model, MODEL_DT), robot, MODEL_DT) * np.array([k_v, k_w])
+        return as_measured(t_model, velocity, t_pose, grid)[inside]
+
+    measured_inside = measured[inside]
 
     def residual(theta, latency):
-        return ((model(theta, latency) - measured) / scale).ravel()
+        return ((model(theta, latency) - measured_inside) / scale).ravel()
 
     # an acceleration limit above the commands' own rate of change never acts (and has no gradient):
     # the search starts below those rates, and a fit at the top of its range means "not limiting"
@@ -137,18 +239,35 @@ def fit(log: dict, robot: str) -> SysidResult:
         if best is None or sol.cost < best[0].cost:
             best = (sol, float(latency))
     sol, latency = best
-    tau, a_v, a_w, k_v, k_w = (float(x) for x in sol.x)
-    simulated = model(sol.x, latency)
+
+    # then latency continuous too (between two model steps: the two neighbouring runs interpolated),
+    # so that a latency between grid points (the mocap's own is 10-30 ms) is not pushed into the lag
+    def residual_all(theta):
+        lat, rest = float(theta[0]), theta[1:]
+        k = math.floor(lat / MODEL_DT + 1e-9)
+        frac = lat / MODEL_DT - k
+        low = model(rest, k * MODEL_DT)
+        both = low if frac < 1e-9 else (1.0 - frac) * low + frac * model(rest, (k + 1) * MODEL_DT)
+        return ((both - measured_inside) / scale).ravel()
+
+    refined = least_squares(residual_all, np.concatenate([[latency], sol.x]), bounds=(np.concatenate([[0.0], lo]), np.concatenate([[LATENCY_GRID[-1]], hi])),
+                            x_scale=np.array([0.01, 0.05, 1.0, 2.0, 0.2, 0.2]), max_nfev=40)
+    if refined.cost <= sol.cost:
+        latency, theta = float(refined.x[0]), refined.x[1:]
+    else:
+        theta = sol.x
+    tau, a_v, a_w, k_v, k_w = (float(x) for x in theta)
+    simulated = measured_inside + residual_all(np.concatenate([[latency], theta])).reshape(-1, 2) * scale
     a_v = math.inf if a_v >= rates[0] else a_v  # not limiting at the rates this log commanded
     a_w = math.inf if a_w >= rates[1] else a_w
-    err = simulated - measured
+    err = simulated - measured_inside
     dynamics = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w,
                             track_scale=float(np.clip(base.track_scale * k_w / k_v, 0.05, 20.0)))
     return SysidResult(
         dynamics, latency, tau, a_v, a_w, k_v, k_w,
         float(np.sqrt(np.mean(err[:, 0] ** 2))), float(np.sqrt(np.mean(err[:, 1] ** 2))),
-        float(grid[-1] - grid[0]), int(len(grid)),
-        {"t": grid, "measured": measured, "simulated": simulated},
+        float(grid[inside][-1] - grid[inside][0]), int(np.sum(inside)),
+        {"t": grid[inside], "measured": measured_inside, "simulated": simulated},
     )
 
 

@@ -22,8 +22,9 @@ from run to run in the order below (the first episode starts from nothing), as o
 every run would keep what it learned. One more, ``hardware_like_model``, uses everything the same
 identification gives: the sysid calibration and the fitted dynamics as the planner's drive model
 (``--drive-model``, ``lbgp.drive_model``: plan within the identified acceleration limits from the
-state predicted one latency ahead). An E2E policy sends its own commands, so for E2E that column
-only repeats the calibrated one's conditions. An E2E policy
+state predicted one latency ahead). ``hardware_like_model_only`` is the drive model without the
+calibration. An E2E policy sends its own commands, so for E2E those two columns only repeat the
+calibrated and the uncalibrated one's conditions. An E2E policy
 trained with domain randomisation (``lbgp train --method e2e --randomize default``) is reported
 beside the shipped one when ``--e2e-randomized`` names it.
 
@@ -61,7 +62,8 @@ from lbgp.sim import scenario_names  # noqa: E402
 CALIBRATED = "hardware_like_calibrated"
 ONLINE = ("nominal_online", "hardware_like_online")
 MODEL = "hardware_like_model"
-COLUMNS = ("nominal", "hardware_like", CALIBRATED, *ONLINE, MODEL)
+MODEL_ONLY = "hardware_like_model_only"
+COLUMNS = ("nominal", "hardware_like", CALIBRATED, *ONLINE, MODEL, MODEL_ONLY)
 
 
 def identified_calibration(robot: str) -> tuple[CommandCalibration, Dynamics, dict]:
@@ -78,13 +80,14 @@ def identified_calibration(robot: str) -> tuple[CommandCalibration, Dynamics, di
 
 
 def runs_of(identified: tuple, robot: str):
-    """(column, dynamics, calibration, drive model) for the six columns (a fresh online estimator for each)."""
+    """(column, dynamics, calibration, drive model) for the seven columns (a fresh online estimator for each)."""
     calibration, drive_model = identified
     return [("nominal", "nominal", None, None), ("hardware_like", "hardware_like", None, None),
             (CALIBRATED, "hardware_like", calibration, None),
             ("nominal_online", "nominal", OnlineCalibration(robot), None),
             ("hardware_like_online", "hardware_like", OnlineCalibration(robot), None),
-            (MODEL, "hardware_like", calibration, drive_model)]
+            (MODEL, "hardware_like", calibration, drive_model),
+            (MODEL_ONLY, "hardware_like", None, drive_model)]
 
 
 def scenario_part(policy, method: str, episodes: int, seed: int, identified: tuple) -> tuple[dict, dict]:
@@ -117,13 +120,15 @@ def totals(part: dict, half_widths: dict) -> dict:
     """Each column's sum with the half-width of its 95 % interval (the rows' combined in quadrature),
     and the share of the nominal robot's kept on the hardware-like one: ``kept`` (no calibration),
     ``kept_calibrated`` (sysid's), ``kept_online`` (online, against the nominal robot driven through
-    the online calibration too), ``kept_model`` (sysid's calibration and drive model), each with a 95 % half-width (``*_ci95``: the two sums' relative
+    the online calibration too), ``kept_model`` (sysid's calibration and drive model),
+    ``kept_model_only`` (sysid's drive model, no calibration), each with a 95 % half-width (``*_ci95``: the two sums' relative
     half-widths in quadrature; conservative, as both columns run the same seeds)."""
     sums = {c: sum(part[c].values()) for c in COLUMNS}
     hw = {c: math.sqrt(sum(h**2 for h in half_widths[c].values())) for c in COLUMNS}
     out = {**{c: round(v, 2) for c, v in sums.items()}, "ci95": {c: round(h, 2) for c, h in hw.items()}}
     for name, a, b in (("kept", "hardware_like", "nominal"), ("kept_calibrated", CALIBRATED, "nominal"),
-                       ("kept_online", "hardware_like_online", "nominal_online"), ("kept_model", MODEL, "nominal")):
+                       ("kept_online", "hardware_like_online", "nominal_online"), ("kept_model", MODEL, "nominal"),
+                       ("kept_model_only", MODEL_ONLY, "nominal")):
         if sums[b] > 0 and sums[a] != 0:
             ratio = sums[a] / sums[b]
             out[name] = round(ratio, 3)

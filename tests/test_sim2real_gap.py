@@ -17,11 +17,13 @@ def test_totals_sum_rows_combine_intervals_in_quadrature_and_give_the_share_kept
     part["hardware_like"] = {"a": 8.0, "b": 4.0}
     part["hardware_like_online"] = {"a": 7.0, "b": 5.0}
     part["hardware_like_model"] = {"a": 10.0, "b": 10.0}
+    part["hardware_like_model_only"] = {"a": 10.0, "b": 2.0}
     half = {c: {"a": 3.0, "b": 4.0} for c in COLUMNS}
     out = totals(part, half)
     assert out["nominal"] == 16.0 and out["hardware_like"] == 12.0
     assert out["ci95"]["nominal"] == 5.0  # sqrt(3^2 + 4^2)
     assert out["kept"] == 0.75 and out["kept_calibrated"] == 1.0 and out["kept_online"] == 0.75 and out["kept_model"] == 1.25
+    assert out["kept_model_only"] == 0.75
     assert out["kept_ci95"] == pytest.approx(0.75 * math.hypot(5 / 12, 5 / 16), abs=1e-3)
 
 

@@ -299,7 +299,7 @@ def plot_fit(result: SysidResult, path) -> None:
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper right")
     axes[1].set_xlabel("time (s)")
-    r = result.summary()
+    r = {k: ("not limiting" if v is None else v) for k, v in result.summary().items()}
     fig.suptitle(f"latency {r['latency_s']} s, tau {r['time_constant_s']} s, accel {r['max_linear_accel']} m/s^2 / "
                  f"{r['max_angular_accel']} rad/s^2, rms {r['rms_v']} m/s / {r['rms_w']} rad/s", fontsize=9)
     fig.tight_layout()

@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from lbgp.actions import MAX_V, MAX_W
+from lbgp.conventions import AGENT_PERIOD
 from lbgp.dynamics import Dynamics, nominal
 from lbgp.drive_train import simulate_setpoints
 
@@ -77,10 +78,6 @@ def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     return t_cmd, u, t_pose, p
 
 
-def _grid(t_pose: np.ndarray, dt: float = VELOCITY_GRID) -> np.ndarray:
-    return np.arange(t_pose[0], t_pose[-1], dt)
-
-
 def _rate(t: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """d/dt of samples ``values`` at times ``t``: linearly interpolated onto the uniform ``grid``,
     then a Savitzky-Golay derivative over ~0.2 s. The one differentiator of the measurement and of
@@ -102,7 +99,7 @@ def _unique_times(t_pose: np.ndarray, poses: np.ndarray) -> tuple[np.ndarray, np
 def measured_velocity(t_pose: np.ndarray, poses: np.ndarray, dt: float = VELOCITY_GRID) -> tuple[np.ndarray, np.ndarray]:
     """(grid times, (v, w) per time): body velocity from poses, on a uniform grid."""
     t, p = _unique_times(t_pose, poses)
-    grid = _grid(t, dt)
+    grid = np.arange(t[0], t[-1], dt)
     yaw = np.unwrap(p[:, 2])
     dx, dy, dyaw = (_rate(t, c, grid) for c in (p[:, 0], p[:, 1], yaw))
     yw = np.interp(grid, t, yaw)
@@ -154,21 +151,22 @@ def measure_base_response(robot: str, time_constants=(0.05, 0.12, 0.2), seed: in
     channel by least squares. Returns ((lead_v, lag_v), (lead_w, lag_w)) in seconds."""
     from scipy.optimize import least_squares
 
-    from lbgp.planner import planner_config_for
+    from lbgp.planner import clamp_command
     from lbgp.real.sim_world import SimWorld
+    from lbgp.stack import planner_limits
 
-    limits = planner_config_for(robot)
-    schedule = np.repeat(excitation_schedule(limits.max_vel_x, limits.max_vel_theta), 2, axis=0)  # 0.2 s -> 0.1 s ticks
-    step_limit = np.array([limits.acc_lim_x, limits.acc_lim_theta]) * 0.1
+    limits = planner_limits(robot)  # the deploy loop's: its tick as the control period
+    ticks_per_step = int(round(AGENT_PERIOD / limits.control_period))  # the schedule holds each command one agent step
+    schedule = np.repeat(excitation_schedule(limits.max_vel_x, limits.max_vel_theta), ticks_per_step, axis=0)
     runs = []
     for tau in time_constants:
         world = SimWorld("standing_person", robot=robot, seed=seed, dynamics=nominal(robot).replace(time_constant=tau))
         physics = world.physics
-        command, rows = np.zeros(2), []
+        command, rows = (0.0, 0.0), []
         for target in schedule:
-            command = command + np.clip(target - command, -step_limit, step_limit)
+            command = clamp_command(*target, *command, limits)
             world.set_command(*command)
-            for _ in range(int(round(0.1 / physics.timestep()))):
+            for _ in range(int(round(limits.control_period / physics.timestep()))):
                 physics.step_physics(1)
                 rows.append((*physics.drivetrain.output, *physics.robot_velocity()))
         runs.append(np.array(rows))
@@ -242,13 +240,14 @@ def fit(log: dict, robot: str) -> SysidResult:
 
     # then latency continuous too (between two model steps: the two neighbouring runs interpolated),
     # so that a latency between grid points (the mocap's own is 10-30 ms) is not pushed into the lag
+    def model_at(latency, theta):
+        k = math.floor(latency / MODEL_DT + 1e-9)
+        frac = latency / MODEL_DT - k
+        low = model(theta, k * MODEL_DT)
+        return low if frac < 1e-9 else (1.0 - frac) * low + frac * model(theta, (k + 1) * MODEL_DT)
+
     def residual_all(theta):
-        lat, rest = float(theta[0]), theta[1:]
-        k = math.floor(lat / MODEL_DT + 1e-9)
-        frac = lat / MODEL_DT - k
-        low = model(rest, k * MODEL_DT)
-        both = low if frac < 1e-9 else (1.0 - frac) * low + frac * model(rest, (k + 1) * MODEL_DT)
-        return ((both - measured_inside) / scale).ravel()
+        return ((model_at(float(theta[0]), theta[1:]) - measured_inside) / scale).ravel()
 
     refined = least_squares(residual_all, np.concatenate([[latency], sol.x]), bounds=(np.concatenate([[0.0], lo]), np.concatenate([[LATENCY_GRID[-1]], hi])),
                             x_scale=np.array([0.01, 0.05, 1.0, 2.0, 0.2, 0.2]), max_nfev=40)
@@ -257,7 +256,7 @@ def fit(log: dict, robot: str) -> SysidResult:
     else:
         theta = sol.x
     tau, a_v, a_w, k_v, k_w = (float(x) for x in theta)
-    simulated = measured_inside + residual_all(np.concatenate([[latency], theta])).reshape(-1, 2) * scale
+    simulated = model_at(latency, theta)
     a_v = math.inf if a_v >= rates[0] else a_v  # not limiting at the rates this log commanded
     a_w = math.inf if a_w >= rates[1] else a_w
     err = simulated - measured_inside

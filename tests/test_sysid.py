@@ -1,6 +1,7 @@
 """System identification from deploy logs recorded in the simulator with known, non-default dynamics
 (mocap noise, latency and dropped frames on), and clear errors for logs it cannot use."""
 
+import json
 import math
 
 import numpy as np
@@ -43,6 +44,9 @@ def test_fit_recovers_the_jackals_latency_and_lag(tmp_path):
     assert r.time_constant == pytest.approx(known.time_constant, rel=0.25)
     assert abs(r.latency - known.latency) <= 0.1
     assert r.max_angular_accel == pytest.approx(known.max_angular_accel, rel=0.2)
+    # no linear limiter configured: reported as not limiting, null in JSON (which has no infinity)
+    assert math.isinf(r.max_linear_accel) and r.summary()["max_linear_accel"] is None
+    assert "Infinity" not in json.dumps(r.summary())
 
 
 def test_model_goes_through_the_measurements_differentiator():

@@ -19,8 +19,9 @@ from lbgp.real import safety
 from lbgp.real.endpoints import open_sink, open_source
 from lbgp.real.frames import FrameError, PoseFrame, decode_frame, encode_frame
 from lbgp.real.loop import SHUTDOWN, DeployConfig, DeployLoop
-from lbgp.real.mcap_log import LogError, read_log
+from lbgp.real.mcap_log import LogError, pose_of, read_log
 from lbgp.real.replay import ReplayClock, replay_log
+from lbgp.real.sim_world import FRAME_PERIOD
 from lbgp.real.udp import UdpCommandListener, UdpCommandSink, UdpPoseSource
 from lbgp.rollout import ConstantGoalPolicy
 
@@ -344,6 +345,16 @@ def test_mcap_round_trip_deploy_log_replay_gives_the_same_metrics(tmp_path):
     assert len(log["/cmd_vel"]) == loop.ticks + 1  # every tick's command and the final zero
     assert json.loads(log["/lbgp/status"][-1][1].data)["status"] == SHUTDOWN
     assert len(log["/lbgp/plan"]) > 0 and len(log["/lbgp/observation"]) == 20
+    # every accepted mocap frame (50 Hz here, 10 Hz ticks), stamped with the source's own clock;
+    # the pose a tick used is the newest frame it read
+    frames = log["/mocap/robot"]
+    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames])
+    assert len(frames) == len(log["/mocap/person"]) >= 4 * len(log["/robot/pose"])
+    assert np.all(np.diff(stamps) > 0)
+    np.testing.assert_allclose(np.diff(stamps), FRAME_PERIOD, atol=1e-6)  # no frame dropped without disturbances
+    newest = {t: pose_of(m) for t, m in frames}  # per tick (log time), the last frame written
+    for t, m in log["/robot/pose"]:
+        np.testing.assert_allclose(pose_of(m), newest[t], atol=1e-9)
     # schemas are ROS 2 message definitions Foxglove knows
     from mcap.reader import make_reader
 

@@ -104,6 +104,7 @@ class TickRecord:
     reward: float = math.nan  # agent steps only
     distance_alpha: tuple = (math.nan, math.nan)  # whenever the tick had good poses
     command_scale: tuple = (1.0, 1.0)  # the calibration's (scale_v, scale_w) applied to this tick's command
+    frames: tuple = ()  # every frame accepted this tick (PoseFrame, source time): logged as /mocap/*
 
 
 class DeployLoop:
@@ -155,7 +156,7 @@ class DeployLoop:
         t_read = time.perf_counter()
         status = self.monitor.update(frames, now)
         frame = self.monitor.last
-        record = TickRecord(now, status, 0.0, 0.0)
+        record = TickRecord(now, status, 0.0, 0.0, frames=tuple(self.monitor.accepted))
         # first data, or back after a long gap (the source's clock may have restarted): start afresh
         resumed = now - self._last_good > self.cfg.safety.reanchor_after
         if status == safety_lib.OK:

@@ -3,6 +3,9 @@
 Topics (frame_id "world"; times are the loop clock added to the wall-clock time at the start):
 
     /robot/pose, /person/pose   geometry_msgs/PoseStamped   poses the tick used (every tick with good data)
+    /mocap/robot, /mocap/person geometry_msgs/PoseStamped   every frame the safety checks accepted (all of the
+                                                             mocap rate); log time: the tick that read it,
+                                                             header stamp: the pose source's own clock
     /cmd_vel                    geometry_msgs/Twist          the command sent (every tick)
     /lbgp/goal                  geometry_msgs/PoseStamped   the goal the planner drives to
     /lbgp/plan                  nav_msgs/Path                the planner's band
@@ -54,6 +57,8 @@ SCHEMAS = {
 TOPICS = {
     "/robot/pose": "geometry_msgs/PoseStamped",
     "/person/pose": "geometry_msgs/PoseStamped",
+    "/mocap/robot": "geometry_msgs/PoseStamped",
+    "/mocap/person": "geometry_msgs/PoseStamped",
     "/cmd_vel": "geometry_msgs/Twist",
     "/lbgp/goal": "geometry_msgs/PoseStamped",
     "/lbgp/plan": "nav_msgs/Path",
@@ -121,6 +126,10 @@ class McapLogger:
         if record.robot is not None:
             self._write("/robot/pose", _pose_msg(record.robot, ns), ns)
             self._write("/person/pose", _pose_msg(record.person, ns), ns)
+        for frame in record.frames:  # stamped with the source's clock: its spacing is the capture's, not the ticks'
+            stamp = max(int(round(frame.t * 1e9)), 0)
+            self._write("/mocap/robot", _pose_msg(frame.robot, stamp), ns)
+            self._write("/mocap/person", _pose_msg(frame.person, stamp), ns)
         self._write("/cmd_vel", {"linear": {"x": record.v, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": record.w}}, ns)
         if record.goal is not None:
             self._write("/lbgp/goal", _pose_msg(record.goal, ns), ns)

@@ -63,6 +63,7 @@ class SafetyMonitor:
         self.last: PoseFrame | None = None  # last accepted frame
         self.last_rejection = ""
         self.counts = {reason: 0 for reason in (NON_FINITE, OUT_OF_ORDER, JUMP)}
+        self.accepted: list[PoseFrame] = []  # the frames the last ``update`` accepted, oldest first
 
     def check(self, frame: PoseFrame) -> str:
         """OK if the frame may be used (and remember it), else the reason it may not."""
@@ -92,8 +93,11 @@ class SafetyMonitor:
         the newest frame's rejection reason if it was bad, NO_DATA before the first good frame,
         STALE when the last good frame is older than ``stale_after``, else OK."""
         newest = OK
+        self.accepted = []
         for frame in frames:
             newest = self.check(frame)
+            if newest == OK:
+                self.accepted.append(frame)
         if newest != OK:
             return newest
         if self.last is None:

@@ -9,8 +9,10 @@ firmware's acceleration limiter, a first-order lag), then the simulated base's r
 setpoints (``SIM_BASE_RESPONSE``: its body runs ahead of a smooth setpoint), then gains on v and w
 (what the wheels and the floor make of the setpoint: servo gain, skid-steer slip). So the fitted
 parameters are the ones that make the simulator reproduce the log. The measured body velocity comes
-from the logged robot poses (interpolated to a uniform grid, Savitzky-Golay derivative), and the
-model's velocity goes through the very same differentiator (``as_measured``). The latency is
+from the logged robot poses (every mocap frame the loop accepted, ``/mocap/robot``; interpolated to
+a uniform grid, Savitzky-Golay derivative), and the model's velocity goes through the very same
+differentiator (``as_measured``). The acceleration limiters are fitted as their inverse, the ramp
+time per unit of command (0: none), so that "no limiter" is a point of the search. The latency is
 searched on a grid up to 0.3 s: every 30 ms with the other parameters at their start values, then
 every 10 ms within 60 ms of the best; for each of those, scipy's ``least_squares`` fits the other
 five parameters; from the best, all six are refined together with the latency continuous.
@@ -53,7 +55,7 @@ class SysidResult:
     def summary(self) -> dict:
         return {
             "latency_s": round(self.latency, 4), "time_constant_s": round(self.time_constant, 4),
-            # None: not limiting at the rates the log commanded (JSON has no infinity)
+            # None: not limiting (passes the log's largest change within a model step; JSON has no infinity)
             "max_linear_accel": _rounded_or_none(self.max_linear_accel, 3), "max_angular_accel": _rounded_or_none(self.max_angular_accel, 3),
             "gain_v": round(self.gain_v, 3), "gain_w": round(self.gain_w, 3),
             "rms_v": round(self.rms_v, 4), "rms_w": round(self.rms_w, 4),
@@ -66,14 +68,25 @@ def _rounded_or_none(value: float, digits: int):
 
 
 def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(command times, commands (v, w), pose times, robot poses (x, y, yaw)) from ``read_log``'s dict."""
+    """(command times, commands (v, w), pose times, robot poses (x, y, yaw)) from ``read_log``'s dict.
+
+    The poses are every mocap frame the loop accepted (``/mocap/robot``) when the log has them: their
+    spacing is the source's own clock, put on the log's clock by the smallest delay seen (the
+    freshest frame a tick read). Logs without them (written before these topics, or a source clock that
+    restarted mid-log) give one pose per tick (``/robot/pose``, the pose each tick used)."""
     from lbgp.real.mcap_log import pose_of
 
     cmds = log.get("/cmd_vel", [])
-    poses = log.get("/robot/pose", [])
     t_cmd = np.array([t for t, _ in cmds], float)
     u = np.array([[m.linear.x, m.angular.z] for _, m in cmds], float).reshape(-1, 2)
-    t_pose = np.array([t for t, _ in poses], float)
+    frames = log.get("/mocap/robot", [])
+    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames], float)
+    if len(frames) >= MIN_POSES and np.all(np.diff(stamps) > 0):
+        t_pose = stamps + np.min(np.array([t for t, _ in frames]) - stamps)
+        poses = frames
+    else:
+        poses = log.get("/robot/pose", [])
+        t_pose = np.array([t for t, _ in poses], float)
     p = np.array([pose_of(m) for _, m in poses], float).reshape(-1, 3)
     return t_cmd, u, t_pose, p
 
@@ -110,9 +123,8 @@ def measured_velocity(t_pose: np.ndarray, poses: np.ndarray, dt: float = VELOCIT
 def as_measured(t_model: np.ndarray, velocity: np.ndarray, t_pose: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """What ``measured_velocity`` makes of a body moving with ``velocity`` ((v, w) held over each
     step of the uniform ``t_model``): distance travelled and heading, sampled at the log's pose
-    times, then the same differentiator. (The log holds one pose per control tick, 10 Hz: its
-    interpolation and smoothing spread a velocity step over ~0.3 s, centred, so a model compared
-    with the raw measurement would have to lead it.)"""
+    times, then the same differentiator. (Interpolating and smoothing the poses spreads a velocity
+    step over ~0.2-0.3 s, centred, so a model compared with the raw measurement would have to lead it.)"""
     dt = float(t_model[1] - t_model[0])
     travelled = np.concatenate([np.zeros((1, 2)), np.cumsum(velocity * dt, axis=0)])  # at t_model[0] + k dt
     t_edges = t_model[0] - dt + dt * np.arange(len(travelled))  # velocity[i] acts over (t_model[i] - dt, t_model[i]]
@@ -209,9 +221,14 @@ def fit(log: dict, robot: str) -> SysidResult:
     scale = np.array([max(np.std(measured[inside, 0]), 0.02), max(np.std(measured[inside, 1]), 0.05)])
     base = nominal(robot)
 
+    # the limiters are fitted as their inverse, the ramp time per unit of command (s per m/s, s per
+    # rad/s): 0 is no limiter, and the fit moves continuously from a step to a ramp. (A limiter just
+    # above the commands' rate of change still turns each tick's step into a ramp as long as the tick,
+    # like a delay of half a tick; as a bound at that rate it pulled the lag and latency short.)
     def model(theta, latency):
-        tau, a_v, a_w, k_v, k_w = theta
-        dyn = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w, latency_jitter=0.0)
+        tau, r_v, r_w, k_v, k_w = theta
+        dyn = base.replace(latency=latency, time_constant=tau, max_linear_accel=_limit(r_v), max_angular_accel=_limit(r_w),
+                           latency_jitter=0.0)
         velocity = base_response(simulate_setpoints(dyn, t_cmd, u, t_model, MODEL_DT), robot, MODEL_DT) * np.array([k_v, k_w])
         return as_measured(t_model, velocity, t_pose, grid)[inside]
 
@@ -220,20 +237,20 @@ def fit(log: dict, robot: str) -> SysidResult:
     def residual(theta, latency):
         return ((model(theta, latency) - measured_inside) / scale).ravel()
 
-    # an acceleration limit above the commands' own rate of change never acts (and has no gradient):
-    # the search starts below those rates, and a fit at the top of its range means "not limiting"
-    rates = np.max(np.abs(np.diff(u, axis=0)) / np.maximum(np.diff(t_cmd), 1e-3)[:, None], axis=0)
-    rates = np.maximum(rates, [0.1, 0.2])
-    lo = np.array([0.0, 0.05, 0.1, 0.3, 0.3])
-    hi = np.array([1.0, 1.05 * rates[0], 1.05 * rates[1], 2.0, 2.0])
-    start = np.array([0.05, 0.5 * rates[0], 0.5 * rates[1], 1.0, 1.0])
+    # the largest command change between two commands: a limiter that ramps it within one model
+    # step acts as none (reported as not limiting)
+    steps = np.maximum(np.max(np.abs(np.diff(u, axis=0)), axis=0), [0.01, 0.02])
+    lo = np.array([0.0, 0.0, 0.0, 0.3, 0.3])
+    hi = np.array([1.0, 1.0 / 0.05, 1.0 / 0.1, 2.0, 2.0])
+    start = np.array([0.05, 0.02 / steps[0], 0.02 / steps[1], 1.0, 1.0])  # a 20 ms ramp on the largest change
+    ramp_scale = 0.05 / steps
+    x_scale = np.array([0.05, ramp_scale[0], ramp_scale[1], 0.2, 0.2])
     best = None
     coarse = [(float(np.sum(residual(start, lat) ** 2)), float(lat)) for lat in LATENCY_GRID[::3]]
     centre = min(coarse)[1]
     candidates = LATENCY_GRID[np.abs(LATENCY_GRID - centre) <= 0.061]
     for latency in candidates:
-        sol = least_squares(residual, start, bounds=(lo, hi), args=(float(latency),), x_scale=np.array([0.05, 1.0, 2.0, 0.2, 0.2]),
-                            max_nfev=60)
+        sol = least_squares(residual, start, bounds=(lo, hi), args=(float(latency),), x_scale=x_scale, max_nfev=60)
         if best is None or sol.cost < best[0].cost:
             best = (sol, float(latency))
     sol, latency = best
@@ -250,15 +267,15 @@ def fit(log: dict, robot: str) -> SysidResult:
         return ((model_at(float(theta[0]), theta[1:]) - measured_inside) / scale).ravel()
 
     refined = least_squares(residual_all, np.concatenate([[latency], sol.x]), bounds=(np.concatenate([[0.0], lo]), np.concatenate([[LATENCY_GRID[-1]], hi])),
-                            x_scale=np.array([0.01, 0.05, 1.0, 2.0, 0.2, 0.2]), max_nfev=40)
+                            x_scale=np.concatenate([[0.01], x_scale]), max_nfev=40)
     if refined.cost <= sol.cost:
         latency, theta = float(refined.x[0]), refined.x[1:]
     else:
         theta = sol.x
-    tau, a_v, a_w, k_v, k_w = (float(x) for x in theta)
+    tau, r_v, r_w, k_v, k_w = (float(x) for x in theta)
     simulated = model_at(latency, theta)
-    a_v = math.inf if a_v >= rates[0] else a_v  # not limiting at the rates this log commanded
-    a_w = math.inf if a_w >= rates[1] else a_w
+    # not limiting: the log's largest change passes within one model step
+    a_v, a_w = (math.inf if r * step <= MODEL_DT else _limit(r) for r, step in ((r_v, steps[0]), (r_w, steps[1])))
     err = simulated - measured_inside
     dynamics = base.replace(latency=latency, time_constant=tau, max_linear_accel=a_v, max_angular_accel=a_w,
                             track_scale=float(np.clip(base.track_scale * k_w / k_v, 0.05, 20.0)))
@@ -268,6 +285,11 @@ def fit(log: dict, robot: str) -> SysidResult:
         float(grid[inside][-1] - grid[inside][0]), int(np.sum(inside)),
         {"t": grid[inside], "measured": measured_inside, "simulated": simulated},
     )
+
+
+def _limit(ramp_time: float) -> float:
+    """An acceleration limit from its inverse (s per unit of command; 0: no limiter)."""
+    return math.inf if ramp_time <= 1e-9 else 1.0 / ramp_time
 
 
 def identify(log_path, robot: str) -> SysidResult:

@@ -1,6 +1,7 @@
 """Planner solve time per call along real simulated episodes, QP accuracy, and the goal-driven env rate.
 
     python benchmarks/bench_planner.py --json results/bench_planner.json
+    python benchmarks/bench_planner.py --json /tmp/tight.json --osqp-eps 1e-4 --osqp-rho 0.01 --sizes 20   # the accuracy trade-off
 
 For each robot and band size (N = 20 and 30 poses): goal-driven episodes of the evaluation
 scenarios are run in MuJoCo with a scripted goal 1.5 m ahead of the person until ``--calls``
@@ -34,8 +35,9 @@ from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.sim import make_env, scenario_names  # noqa: E402
 
 
-def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0) -> dict:
-    cfg = planner_config_for(robot).with_(n_poses=n_poses)
+def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) -> dict:
+    """``overrides``: PlannerConfig fields to change (e.g. osqp_eps, osqp_rho)."""
+    cfg = planner_config_for(robot).with_(n_poses=n_poses, **overrides)
     times, statuses, iterations, candidates, recorded = [], [], [], [], []
     action = action_from_goal([1.5, 0.0])
     steps, t_env = 0, 0.0
@@ -114,11 +116,16 @@ def main() -> None:
     parser.add_argument("--json", required=True)
     parser.add_argument("--calls", type=int, default=1000)
     parser.add_argument("--accuracy", type=int, default=200, help="QPs checked against a tight reference (N = 20)")
+    parser.add_argument("--osqp-eps", type=float, default=None, help="override PlannerConfig.osqp_eps (default: the robot's config)")
+    parser.add_argument("--osqp-rho", type=float, default=None, help="override PlannerConfig.osqp_rho")
+    parser.add_argument("--sizes", default="20,30", help="band sizes N to measure, comma-separated")
     args = parser.parse_args()
+    overrides = {k: v for k, v in (("osqp_eps", args.osqp_eps), ("osqp_rho", args.osqp_rho)) if v is not None}
     result = {
-        f"{robot}_N{n}": bench(robot, n, args.calls, args.accuracy if n == 20 else 0)
-        for robot in ("jackal", "turtlebot2") for n in (20, 30)
+        f"{robot}_N{n}": bench(robot, n, args.calls, args.accuracy if n == 20 else 0, **overrides)
+        for robot in ("jackal", "turtlebot2") for n in (int(x) for x in args.sizes.split(","))
     }
+    result["osqp_settings"] = {k: getattr(planner_config_for("jackal").with_(**overrides), k) for k in ("osqp_eps", "osqp_rho", "osqp_max_iter")}
     write_result(args.json, result)
 
 

@@ -57,3 +57,26 @@ def test_infeasible_and_capped_problems_say_so():
     A, q, lower, upper = values(rng, pattern, n, m)
     assert capped.solve(A.data, q, lower, upper) == FAILED
     assert capped.stats.max_iter_hits == 1
+
+
+def test_restart_returns_to_the_configured_initial_rho():
+    """``rho`` reaches OSQP at setup and at every ``restart``: after other solves, a restarted solver
+    repeats its first solve iteration for iteration, and another rho takes another path."""
+    rng = np.random.default_rng(2)
+    n, m = 12, 18
+    P, pattern = random_problem(rng, n, m)
+    first, second = values(rng, pattern, n, m), values(rng, pattern, n, m)
+
+    def iterations(rho):
+        qp = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-7, max_iter=20000, rho=rho)
+        counts = []
+        for A, q, lower, upper in (first, second, first):
+            before = qp.stats.osqp_iterations
+            qp.restart()
+            assert qp.solve(A.data, q, lower, upper) == SOLVED
+            counts.append(qp.stats.osqp_iterations - before)
+        return counts
+
+    fast, slow = iterations(0.1), iterations(0.001)
+    assert fast[0] == fast[2] and slow[0] == slow[2]
+    assert fast[0] != slow[0]

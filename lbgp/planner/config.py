@@ -58,6 +58,7 @@ class PlannerConfig:
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)
     osqp_max_iter: int = 4000
     osqp_eps: float = 1e-3  # absolute and relative tolerance of every QP, then polished (exact active set)
+    osqp_rho: float = 0.1  # OSQP's initial ADMM step size (its default), where every call's first QP starts
 
     @property
     def safety_distance(self) -> float:

@@ -45,11 +45,12 @@ class SparseQP:
     pattern's order), q, l and u. OSQP warm-starts from the previous solution until ``restart``
     (only iterations change: every solve runs to ``eps`` and is then polished)."""
 
-    def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int):
+    def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int,
+                 rho: float = 0.1):
         self.n, self.m = n, m
         self._P = sp.csc_matrix((np.asarray(P_values, dtype=float), *P_pattern), shape=(n, n))
         self._A_pattern = A_pattern
-        self._rho = 0.1  # OSQP's default initial step size, set explicitly so that restart() can return to it
+        self._rho = rho  # the initial step size, set explicitly so that restart() can return to it
         self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter,
                               rho=self._rho)
         self._solver = None

@@ -42,7 +42,7 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
     action = action_from_goal([1.5, 0.0])
     steps, t_env = 0, 0.0
     scenarios = scenario_names()
-    totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "unpolished": 0}
+    totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "unpolished": 0, "refined": 0, "refine_fallbacks": 0}
     i = 0
     while len(times) < calls:
         env = make_env(scenarios[i % len(scenarios)], robot=robot, seed=i, planner_config=cfg)
@@ -92,6 +92,8 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
         "osqp_iterations_per_qp": totals["osqp_iterations"] / max(totals["solves"], 1),
         "osqp_iteration_cap_hits": totals["max_iter_hits"],
         "unpolished_qps": totals["unpolished"],
+        "refined_qps": totals["refined"],  # polishing failed, continued to osqp_refine_eps (when set)
+        "refine_fallbacks": totals["refine_fallbacks"],
         "goal_env_steps_per_s": steps / t_env,
     }
     if accuracy:
@@ -118,14 +120,16 @@ def main() -> None:
     parser.add_argument("--accuracy", type=int, default=200, help="QPs checked against a tight reference (N = 20)")
     parser.add_argument("--osqp-eps", type=float, default=None, help="override PlannerConfig.osqp_eps (default: the robot's config)")
     parser.add_argument("--osqp-rho", type=float, default=None, help="override PlannerConfig.osqp_rho")
+    parser.add_argument("--osqp-refine-eps", type=float, default=None, help="override PlannerConfig.osqp_refine_eps")
     parser.add_argument("--sizes", default="20,30", help="band sizes N to measure, comma-separated")
     args = parser.parse_args()
-    overrides = {k: v for k, v in (("osqp_eps", args.osqp_eps), ("osqp_rho", args.osqp_rho)) if v is not None}
+    overrides = {k: v for k, v in (("osqp_eps", args.osqp_eps), ("osqp_rho", args.osqp_rho), ("osqp_refine_eps", args.osqp_refine_eps))
+                 if v is not None}
     result = {
         f"{robot}_N{n}": bench(robot, n, args.calls, args.accuracy if n == 20 else 0, **overrides)
         for robot in ("jackal", "turtlebot2") for n in (int(x) for x in args.sizes.split(","))
     }
-    result["osqp_settings"] = {k: getattr(planner_config_for("jackal").with_(**overrides), k) for k in ("osqp_eps", "osqp_rho", "osqp_max_iter")}
+    result["osqp_settings"] = {k: getattr(planner_config_for("jackal").with_(**overrides), k) for k in ("osqp_eps", "osqp_rho", "osqp_max_iter", "osqp_refine_eps", "osqp_refine_max_iter")}
     write_result(args.json, result)
 
 

@@ -80,3 +80,29 @@ def test_restart_returns_to_the_configured_initial_rho():
     fast, slow = iterations(0.1), iterations(0.001)
     assert fast[0] == fast[2] and slow[0] == slow[2]
     assert fast[0] != slow[0]
+
+
+def test_refinement_makes_unpolished_solutions_accurate():
+    """A solve that polishing could not confirm is continued to ``refine_eps`` (counted as refined);
+    polished solves are left alone. Without refinement such solutions are accurate to eps only."""
+    rng = np.random.default_rng(3)
+    n, m = 12, 18
+    P, pattern = random_problem(rng, n, m)
+    plain = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-2, max_iter=20000)
+    refined = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-2, max_iter=20000,
+                       refine_eps=1e-8, refine_max_iter=20000)
+    errors_plain, errors_refined = [], []
+    for _ in range(60):
+        A, q, lower, upper = values(rng, pattern, n, m)
+        reference = osqp.OSQP()
+        reference.setup(P, q, A, lower, upper, verbose=False, eps_abs=1e-10, eps_rel=1e-10, max_iter=100000, polishing=True)
+        x = reference.solve(raise_error=False).x
+        for qp, errors in ((plain, errors_plain), (refined, errors_refined)):
+            unpolished = qp.stats.unpolished + qp.stats.refined
+            qp.restart()
+            assert qp.solve(A.data, q, lower, upper) == SOLVED
+            if qp.stats.unpolished + qp.stats.refined > unpolished:  # this one was not confirmed by polishing
+                errors.append(np.max(np.abs(qp.x - x)))
+    assert plain.stats.unpolished >= 2 and refined.stats.refined == plain.stats.unpolished
+    assert refined.stats.refine_fallbacks == 0
+    assert max(errors_refined) < 1e-5 < max(errors_plain)

@@ -33,7 +33,9 @@ class QPStats:
     osqp_iterations: int = 0
     max_iter_hits: int = 0
     inaccurate: int = 0
-    unpolished: int = 0
+    unpolished: int = 0  # after the refinement pass, where one ran
+    refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
+    refine_fallbacks: int = 0  # ... whose refinement stopped at its iteration cap (the first pass's solution kept)
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -43,16 +45,21 @@ class SparseQP:
     """minimize 1/2 x'Px + q'x  subject to  l <= Ax <= u, with P (upper triangle) and A of a fixed
     pattern given once as CSC ``(indices, indptr)``; ``solve`` takes the new values of A (in the
     pattern's order), q, l and u. OSQP warm-starts from the previous solution until ``restart``
-    (only iterations change: every solve runs to ``eps`` and is then polished)."""
+    (only iterations change: every solve runs to ``eps`` and is then polished). With ``refine_eps``,
+    a solution whose polishing failed is continued to that tolerance and polished again (at most
+    ``refine_max_iter`` more iterations; at the cap the first solution stands)."""
 
     def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int,
-                 rho: float = 0.1):
+                 rho: float = 0.1, refine_eps: float | None = None, refine_max_iter: int = 1000):
         self.n, self.m = n, m
         self._P = sp.csc_matrix((np.asarray(P_values, dtype=float), *P_pattern), shape=(n, n))
         self._A_pattern = A_pattern
         self._rho = rho  # the initial step size, set explicitly so that restart() can return to it
         self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter,
                               rho=self._rho)
+        # a solve whose active set polishing did not confirm continues (warm) to refine_eps and is
+        # polished again; if that pass hits its cap, the first pass's solution stands
+        self._eps, self._refine_eps, self._refine_max_iter, self._max_iter = eps, refine_eps, refine_max_iter, max_iter
         self._solver = None
         self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite
         self.stats = QPStats()
@@ -96,13 +103,35 @@ class SparseQP:
             stats.max_iter_hits += 1
         if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
             stats.inaccurate += 1
-        if info.status_polish != 1:
+        refine = info.status_polish != 1 and self._refine_eps is not None and status in _SOLVED
+        if info.status_polish != 1 and not refine:
             stats.unpolished += 1
         if status in _INFEASIBLE:
             return PRIMAL_INFEASIBLE
         if status not in _SOLVED:
             return FAILED
         self.x = np.array(self._solver.solution.x, dtype=float)
+        if refine:
+            self._refine()
         if not np.all(np.isfinite(self.x)):
             return FAILED
         return SOLVED
+
+    def _refine(self) -> None:
+        stats = self.stats
+        stats.refined += 1
+        self._wrapper.update_settings(eps_abs=self._refine_eps, eps_rel=self._refine_eps, max_iter=self._refine_max_iter)
+        try:
+            self._solver.solve()  # from the first pass's iterate
+            info = self._solver.info
+            stats.osqp_iterations += int(info.iter)
+            if info.status_val in _SOLVED:
+                x = np.array(self._solver.solution.x, dtype=float)
+                if np.all(np.isfinite(x)):
+                    self.x = x
+                stats.unpolished += info.status_polish != 1
+            else:
+                stats.refine_fallbacks += 1
+                stats.unpolished += 1
+        finally:
+            self._wrapper.update_settings(eps_abs=self._eps, eps_rel=self._eps, max_iter=self._max_iter)

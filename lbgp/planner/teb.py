@@ -345,7 +345,8 @@ class TebPlanner:
         self._kin_pos, self._clear_pos = position[self._kin_at], position[self._clear_at]
         self._Ax = A[A_rows, A_cols]  # the constant entries; band-dependent ones are set per QP
         self._qp = SparseQP(n, m, np.triu(P)[P_at], (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),
-                            cfg.osqp_eps, cfg.osqp_max_iter, cfg.osqp_rho)
+                            cfg.osqp_eps, cfg.osqp_max_iter, cfg.osqp_rho,
+                            cfg.osqp_refine_eps, cfg.osqp_refine_max_iter)
         self._q = np.zeros(n)
         self._q[S:] = cfg.weight_clearance_l1
         self._lo = np.zeros(m)

@@ -277,7 +277,7 @@ def cmd_sysid(args) -> int:
 
     result = identify(args.log_file, args.robot)
     summary = result.summary()
-    print(f"lbgp sysid: {args.log_file}, robot {args.robot}, {summary['duration_s']} s of data")
+    print(f"lbgp sysid: {args.log_file}, robot {args.robot}, {summary['duration_s']} s of data, {result.poses} poses from {result.pose_topic}")
     for key, value in summary.items():
         print(f"  {key:<18}{'not limiting' if value is None else value}")
     if args.out:

@@ -13,7 +13,7 @@ from lbgp.dynamics import Dynamics, load_dynamics
 from lbgp.real.mcap_log import LogError
 from lbgp.real.mcap_log import read_log
 from lbgp.real.sysid import (SIM_BASE_RESPONSE, as_measured, identify, log_series, measure_base_response, measured_velocity,
-                              record_excitation)
+                              pose_topic, record_excitation)
 
 KNOWN = Dynamics(latency=0.12, time_constant=0.15, max_linear_accel=0.45, max_angular_accel=1.6)
 
@@ -54,7 +54,7 @@ def test_poses_are_every_mocap_frame_on_the_logs_clock(excitation_log):
     log = read_log(excitation_log)
     t_log = np.array([t for t, _ in log["/mocap/robot"]])
     _, _, t_pose, poses = log_series(log)
-    assert len(t_pose) == len(t_log) > 4 * len(log["/robot/pose"])
+    assert pose_topic(log) == "/mocap/robot" and len(t_pose) == len(t_log) > 4 * len(log["/robot/pose"])
     # the source's spacing, shifted by the smallest delay seen: no frame lies after the tick that read it
     assert np.all(t_pose <= t_log + 1e-9) and np.min(t_log - t_pose) == pytest.approx(0.0, abs=1e-9)
     # a source clock that restarts mid-log cannot be put on the log's clock: the ticks' poses are used
@@ -62,7 +62,7 @@ def test_poses_are_every_mocap_frame_on_the_logs_clock(excitation_log):
     for _, m in frames[len(frames) // 2:]:
         m.header.stamp.sec -= 3
     _, _, t_ticks, _ = log_series(log)
-    assert len(t_ticks) == len(log["/robot/pose"])
+    assert pose_topic(log) == "/robot/pose" and len(t_ticks) == len(log["/robot/pose"])
 
 
 def test_model_goes_through_the_measurements_differentiator():
@@ -125,7 +125,8 @@ def test_cli_writes_dynamics_that_load_and_a_plot(excitation_log, tmp_path, caps
     fitted = load_dynamics(out, "turtlebot2")
     assert fitted.max_linear_accel == pytest.approx(KNOWN.max_linear_accel, rel=0.1)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "rms_v" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "rms_v" in printed and "poses from /mocap/robot" in printed
 
 
 def test_corrupt_and_short_logs_give_clear_errors(excitation_log, tmp_path):

@@ -51,6 +51,8 @@ class SysidResult:
     duration: float  # s of data used
     samples: int
     series: dict  # t, measured and simulated v and w (for the plot)
+    pose_topic: str = "/robot/pose"  # where the poses came from (``pose_topic``)
+    poses: int = 0  # how many
 
     def summary(self) -> dict:
         return {
@@ -67,26 +69,31 @@ def _rounded_or_none(value: float, digits: int):
     return None if math.isinf(value) else round(value, digits)
 
 
+def pose_topic(log: dict) -> str:
+    """Where ``log_series`` takes the robot's poses from: ``/mocap/robot``, every mocap frame the loop
+    accepted, when the log has them on a source clock that never went back; else ``/robot/pose``,
+    one pose per tick (logs written before those topics, or a source clock that restarted mid-log)."""
+    frames = log.get("/mocap/robot", [])
+    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames], float)
+    return "/mocap/robot" if len(frames) >= MIN_POSES and np.all(np.diff(stamps) > 0) else "/robot/pose"
+
+
 def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(command times, commands (v, w), pose times, robot poses (x, y, yaw)) from ``read_log``'s dict.
 
-    The poses are every mocap frame the loop accepted (``/mocap/robot``) when the log has them: their
-    spacing is the source's own clock, put on the log's clock by the smallest delay seen (the
-    freshest frame a tick read). Logs without them (written before these topics, or a source clock that
-    restarted mid-log) give one pose per tick (``/robot/pose``, the pose each tick used)."""
+    The poses come from ``pose_topic``. Mocap frames keep the source's own spacing, put on the log's
+    clock by the smallest delay seen (the freshest frame a tick read)."""
     from lbgp.real.mcap_log import pose_of
 
     cmds = log.get("/cmd_vel", [])
     t_cmd = np.array([t for t, _ in cmds], float)
     u = np.array([[m.linear.x, m.angular.z] for _, m in cmds], float).reshape(-1, 2)
-    frames = log.get("/mocap/robot", [])
-    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames], float)
-    if len(frames) >= MIN_POSES and np.all(np.diff(stamps) > 0):
-        t_pose = stamps + np.min(np.array([t for t, _ in frames]) - stamps)
-        poses = frames
-    else:
-        poses = log.get("/robot/pose", [])
-        t_pose = np.array([t for t, _ in poses], float)
+    topic = pose_topic(log)
+    poses = log.get(topic, [])
+    t_pose = np.array([t for t, _ in poses], float)
+    if topic == "/mocap/robot":
+        stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in poses], float)
+        t_pose = stamps + np.min(t_pose - stamps)
     p = np.array([pose_of(m) for _, m in poses], float).reshape(-1, 3)
     return t_cmd, u, t_pose, p
 
@@ -283,7 +290,7 @@ def fit(log: dict, robot: str) -> SysidResult:
         dynamics, latency, tau, a_v, a_w, k_v, k_w,
         float(np.sqrt(np.mean(err[:, 0] ** 2))), float(np.sqrt(np.mean(err[:, 1] ** 2))),
         float(grid[inside][-1] - grid[inside][0]), int(np.sum(inside)),
-        {"t": grid[inside], "measured": measured_inside, "simulated": simulated},
+        {"t": grid[inside], "measured": measured_inside, "simulated": simulated}, pose_topic(log), len(t_pose),
     )
 
 

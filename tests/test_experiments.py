@@ -165,6 +165,25 @@ def test_winner_only_where_the_confidence_intervals_separate():
     assert winner({"lbgp": 10.0, "hc": 8.0}) == "lbgp"  # without intervals: the best mean
 
 
+def test_head_to_head_counts_separated_and_overlapping_rows(tmp_path):
+    from lbgp.experiments.tables import head_to_head, head_to_head_csv, write_tables
+
+    def row(scenario, method, reward, ci):
+        return {"scenario": scenario, "method": method, "reward": reward, "reward_ci95": ci, "distance_mean": 1.5,
+                "distance_std": 0.1, "alpha_mean_deg": 0.0, "alpha_std_deg": 1.0, "collisions": 0, "terminated_early": 0}
+
+    rows = [row("a", "lbgp", 10.0, 0.5), row("a", "hc", 8.0, 0.5),  # higher, separated
+            row("b", "lbgp", 9.0, 0.5), row("b", "hc", 9.5, 0.5),  # overlap, lower mean
+            row("c", "lbgp", 5.0, 0.1), row("c", "hc", 7.0, 0.1),  # lower, separated
+            row("d", "lbgp", 4.0, 0.1), row("d", "e2e", 1.0, 0.1)]  # no HC: not counted
+    want = {"rows": 3, "higher": 1, "lower": 1, "overlap": 1, "mean_at_least": 1}
+    assert head_to_head(rows, ["scenario"]) == want
+    write_tables(rows, ["scenario"], {}, tmp_path / "t.md", tmp_path / "t.csv", "title", "preamble")
+    assert head_to_head_csv(tmp_path / "t.csv") == want
+    assert "higher in 1 and lower in 1 of 3 rows" in (tmp_path / "t.md").read_text()
+    assert head_to_head([row("a", "lbgp", 1.0, 0.1)], ["scenario"]) is None
+
+
 def test_reward_confidence_interval_is_students_t():
     from lbgp.metrics import reward_ci95
 

@@ -32,6 +32,31 @@ def winner(rewards: dict, ci95: dict | None = None) -> str:
     return best if all(low > valid[m] + half[m] for m in valid if m != best) else TIE
 
 
+def head_to_head(rows: list[dict], group_keys: list[str], a: str = "lbgp", b: str = "hc") -> dict | None:
+    """Method ``a`` against ``b`` over the groups that have both: in how many its reward is higher or
+    lower with the 95 % intervals separated, in how many they overlap, and in how many its mean is at
+    least ``b``'s. ``rows`` as ``write_tables`` takes them (or read back from its CSV). None when no
+    group has both."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(tuple(r[k] for k in group_keys), {})[r["method"]] = (float(r["reward"]), float(r.get("reward_ci95", math.nan)))
+    pairs = [(m[a], m[b]) for m in groups.values() if a in m and b in m]
+    if not pairs:
+        return None
+    higher = sum(1 for (ra, ca), (rb, cb) in pairs if ra - ca > rb + cb)
+    lower = sum(1 for (ra, ca), (rb, cb) in pairs if rb - cb > ra + ca)
+    return {"rows": len(pairs), "higher": higher, "lower": lower, "overlap": len(pairs) - higher - lower,
+            "mean_at_least": sum(1 for (ra, _), (rb, _) in pairs if ra >= rb)}
+
+
+def head_to_head_csv(path, a: str = "lbgp", b: str = "hc") -> dict | None:
+    """``head_to_head`` of a table's CSV (``results/sim_table.csv``, ``results/real_protocol*_table.csv``)."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    group_keys = [k for k in rows[0] if k in ("scenario", "path", "setting")] if rows else []
+    return head_to_head(rows, group_keys, a, b)
+
+
 def _fmt_ours(row: dict) -> tuple[str, str, str]:
     ci = row.get("reward_ci95", math.nan)
     reward = f"{row['reward']:.2f}" + (f" ± {ci:.2f}" if not math.isnan(ci) else "")
@@ -93,6 +118,11 @@ def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: P
     ties = sum(1 for _, o, _ in summary if o == TIE)
     md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here, {ties} are ties (the paper: "
              f"{sum(1 for _, _, p in summary if p == 'lbgp')} of {len(summary)}).\n")
+    h2h = head_to_head(rows, group_keys)
+    if h2h is not None:
+        md.write(f"\nLBGP against HC (the learned goal against the hand-crafted one, the same planner): higher in "
+                 f"{h2h['higher']} and lower in {h2h['lower']} of {h2h['rows']} rows with the 95 % intervals separated, "
+                 f"overlapping in {h2h['overlap']}; the higher or equal mean in {h2h['mean_at_least']}.\n")
     write_text(out_md, md.getvalue())
     buf = io.StringIO()
     if csv_rows:

@@ -48,7 +48,8 @@ class PersonEKF:
         self.R = np.diag([pos_std**2, pos_std**2, yaw_std**2])
         self.acc_std, self.yaw_acc_std = acc_std, yaw_acc_std
         self.turn_rate = turn_rate
-        self.H = np.hstack([np.eye(3), np.zeros((3, 2))])
+        self.H = np.hstack([np.eye(3), np.zeros((3, 2))])  # measurement: the pose; the products with it are slices below
+        self._accel_cov = np.diag([acc_std**2, yaw_acc_std**2])
         self.state: np.ndarray | None = None
         self.P = np.eye(5)
 
@@ -61,7 +62,7 @@ class PersonEKF:
         self.state = ctrv(self.state, dt)
         G = np.array([[0.5 * dt**2 * math.cos(self.state[2]), 0.0], [0.5 * dt**2 * math.sin(self.state[2]), 0.0],
                       [0.0, 0.5 * dt**2], [dt, 0.0], [0.0, dt]])
-        Q = G @ np.diag([self.acc_std**2, self.yaw_acc_std**2]) @ G.T
+        Q = G @ self._accel_cov @ G.T
         self.P = F @ self.P @ F.T + Q
         if not self.turn_rate:
             self.state[4] = 0.0
@@ -69,15 +70,23 @@ class PersonEKF:
 
     def update(self, pose) -> None:
         """Fuse a measured pose; ``None`` (a dropped frame) or a non-finite pose is skipped."""
-        if pose is None or not np.all(np.isfinite(pose)):
+        if pose is None:
             return
-        innovation = np.asarray(pose, dtype=float) - self.state[:3]
+        pose = np.asarray(pose, dtype=float)
+        if not (math.isfinite(pose[0]) and math.isfinite(pose[1]) and math.isfinite(pose[2])):
+            return
+        innovation = pose - self.state[:3]
         innovation[2] = wrap_angle(innovation[2])
-        S = self.H @ self.P @ self.H.T + self.R
-        K = self.P @ self.H.T @ np.linalg.inv(S)
+        # H = [I 0]: H P H' is P's top-left block, P H' its first three columns, K H is K beside zeros
+        # (the same numbers as the products, without them)
+        P = self.P
+        S = P[:3, :3] + self.R
+        K = P[:, :3] @ np.linalg.inv(S)
         self.state = self.state + K @ innovation
         self.state[2] = wrap_angle(self.state[2])
-        self.P = (np.eye(5) - K @ self.H) @ self.P
+        I_KH = np.eye(5)
+        I_KH[:, :3] -= K
+        self.P = I_KH @ P
 
     def step(self, pose, dt: float) -> np.ndarray:
         """Predict ``dt`` then fuse ``pose`` (or start the filter on the first pose)."""

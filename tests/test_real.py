@@ -19,7 +19,7 @@ from lbgp.real import safety
 from lbgp.real.endpoints import open_sink, open_source
 from lbgp.real.frames import FrameError, PoseFrame, decode_frame, encode_frame
 from lbgp.real.loop import SHUTDOWN, DeployConfig, DeployLoop
-from lbgp.real.mcap_log import LogError, pose_of, read_log
+from lbgp.real.mcap_log import LogError, pose_of, read_log, stamp_of
 from lbgp.real.replay import ReplayClock, replay_log
 from lbgp.real.sim_world import FRAME_PERIOD
 from lbgp.real.udp import UdpCommandListener, UdpCommandSink, UdpPoseSource
@@ -348,7 +348,7 @@ def test_mcap_round_trip_deploy_log_replay_gives_the_same_metrics(tmp_path):
     # every accepted mocap frame (50 Hz here, 10 Hz ticks), stamped with the source's own clock;
     # the pose a tick used is the newest frame it read
     frames = log["/mocap/robot"]
-    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames])
+    stamps = np.array([stamp_of(m) for _, m in frames])
     assert len(frames) == len(log["/mocap/person"]) >= 4 * len(log["/robot/pose"])
     assert np.all(np.diff(stamps) > 0)
     np.testing.assert_allclose(np.diff(stamps), FRAME_PERIOD, atol=1e-6)  # no frame dropped without disturbances

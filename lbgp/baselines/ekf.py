@@ -48,7 +48,6 @@ class PersonEKF:
         self.R = np.diag([pos_std**2, pos_std**2, yaw_std**2])
         self.acc_std, self.yaw_acc_std = acc_std, yaw_acc_std
         self.turn_rate = turn_rate
-        self.H = np.hstack([np.eye(3), np.zeros((3, 2))])  # measurement: the pose; the products with it are slices below
         self._accel_cov = np.diag([acc_std**2, yaw_acc_std**2])
         self.state: np.ndarray | None = None
         self.P = np.eye(5)

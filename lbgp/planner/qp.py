@@ -59,7 +59,7 @@ class SparseQP:
                               rho=self._rho)
         # a solve whose active set polishing did not confirm continues (warm) to refine_eps and is
         # polished again; if that pass hits its cap, the first pass's solution stands
-        self._eps, self._refine_eps, self._refine_max_iter, self._max_iter = eps, refine_eps, refine_max_iter, max_iter
+        self._refine_eps, self._refine_max_iter = refine_eps, refine_max_iter
         self._solver = None
         self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite
         self.stats = QPStats()
@@ -134,4 +134,5 @@ class SparseQP:
                 stats.refine_fallbacks += 1
                 stats.unpolished += 1
         finally:
-            self._wrapper.update_settings(eps_abs=self._eps, eps_rel=self._eps, max_iter=self._max_iter)
+            settings = self._settings
+            self._wrapper.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"], max_iter=settings["max_iter"])

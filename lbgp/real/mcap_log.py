@@ -207,6 +207,11 @@ def pose_of(msg) -> np.ndarray:
     return np.array([msg.pose.position.x, msg.pose.position.y, yaw_from_quaternion(q.x, q.y, q.z, q.w)])
 
 
+def stamp_of(msg) -> float:
+    """A stamped message's header time in seconds (for /mocap/*: the pose source's own clock)."""
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
 def frames_of(log: dict) -> list[PoseFrame]:
     """The (robot, person) frames of a log, paired by time."""
     people = {round(t, 6): pose_of(m) for t, m in log["/person/pose"]}

@@ -73,26 +73,28 @@ def pose_topic(log: dict) -> str:
     """Where ``log_series`` takes the robot's poses from: ``/mocap/robot``, every mocap frame the loop
     accepted, when the log has them on a source clock that never went back; else ``/robot/pose``,
     one pose per tick (logs written before those topics, or a source clock that restarted mid-log)."""
+    from lbgp.real.mcap_log import stamp_of
+
     frames = log.get("/mocap/robot", [])
-    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in frames], float)
+    stamps = np.array([stamp_of(m) for _, m in frames], float)
     return "/mocap/robot" if len(frames) >= MIN_POSES and np.all(np.diff(stamps) > 0) else "/robot/pose"
 
 
-def log_series(log: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def log_series(log: dict, topic: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(command times, commands (v, w), pose times, robot poses (x, y, yaw)) from ``read_log``'s dict.
 
-    The poses come from ``pose_topic``. Mocap frames keep the source's own spacing, put on the log's
+    The poses come from ``topic`` (default: ``pose_topic(log)``). Mocap frames keep the source's own spacing, put on the log's
     clock by the smallest delay seen (the freshest frame a tick read)."""
-    from lbgp.real.mcap_log import pose_of
+    from lbgp.real.mcap_log import pose_of, stamp_of
 
     cmds = log.get("/cmd_vel", [])
     t_cmd = np.array([t for t, _ in cmds], float)
     u = np.array([[m.linear.x, m.angular.z] for _, m in cmds], float).reshape(-1, 2)
-    topic = pose_topic(log)
+    topic = topic or pose_topic(log)
     poses = log.get(topic, [])
     t_pose = np.array([t for t, _ in poses], float)
     if topic == "/mocap/robot":
-        stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for _, m in poses], float)
+        stamps = np.array([stamp_of(m) for _, m in poses], float)
         t_pose = stamps + np.min(t_pose - stamps)
     p = np.array([pose_of(m) for _, m in poses], float).reshape(-1, 3)
     return t_cmd, u, t_pose, p
@@ -219,7 +221,8 @@ def fit(log: dict, robot: str) -> SysidResult:
     """Fit the drive-train parameters to a log (``read_log``'s dict)."""
     from scipy.optimize import least_squares
 
-    t_cmd, u, t_pose, p = log_series(log)
+    topic = pose_topic(log)
+    t_cmd, u, t_pose, p = log_series(log, topic)
     _check_log(t_cmd, u, t_pose, p)
     t_pose, p = _unique_times(t_pose, p)
     grid, measured = measured_velocity(t_pose, p)
@@ -290,7 +293,7 @@ def fit(log: dict, robot: str) -> SysidResult:
         dynamics, latency, tau, a_v, a_w, k_v, k_w,
         float(np.sqrt(np.mean(err[:, 0] ** 2))), float(np.sqrt(np.mean(err[:, 1] ** 2))),
         float(grid[inside][-1] - grid[inside][0]), int(np.sum(inside)),
-        {"t": grid[inside], "measured": measured_inside, "simulated": simulated}, pose_topic(log), len(t_pose),
+        {"t": grid[inside], "measured": measured_inside, "simulated": simulated}, topic, len(t_pose),
     )
 
 

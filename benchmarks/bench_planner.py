@@ -2,12 +2,14 @@
 
     python benchmarks/bench_planner.py --json results/bench_planner.json
     python benchmarks/bench_planner.py --json /tmp/tight.json --osqp-eps 1e-4 --osqp-rho 0.01 --sizes 20   # the accuracy trade-off
+    python benchmarks/bench_planner.py --json /tmp/norefine.json --osqp-refine-eps 0 --sizes 20     # without refinement
 
 For each robot and band size (N = 20 and 30 poses): goal-driven episodes of the evaluation
 scenarios are run in MuJoCo with a scripted goal 1.5 m ahead of the person until ``--calls``
 planner calls were made; each call's wall time is recorded (median, p99, max), with the OSQP
-iterations per QP, how often the iteration cap was hit, how often polishing failed (the solution
-is then accurate to ``osqp_eps`` only), the SQP iterations per call and which candidate bands won.
+iterations per QP, how often the iteration cap was hit (and whether a fresh solver then solved the
+QP), how often polishing failed (the QP is then refined to ``osqp_refine_eps``, or, without
+refinement, accurate to ``osqp_eps`` only), the SQP iterations per call and which candidate bands won.
 
 Accuracy (N = 20): ``--accuracy`` QPs recorded along those episodes are solved again from scratch
 to a tight tolerance (eps 1e-9, polished); reported is how far the planner's returned step of the
@@ -42,7 +44,7 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
     action = action_from_goal([1.5, 0.0])
     steps, t_env = 0, 0.0
     scenarios = scenario_names()
-    totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "unpolished": 0, "refined": 0, "refine_fallbacks": 0}
+    totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "rescues": 0, "rescue_failures": 0, "unpolished": 0, "refined": 0, "refine_capped": 0, "refine_fallbacks": 0}
     i = 0
     while len(times) < calls:
         env = make_env(scenarios[i % len(scenarios)], robot=robot, seed=i, planner_config=cfg)
@@ -91,8 +93,11 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
         "qp_solves": totals["solves"],
         "osqp_iterations_per_qp": totals["osqp_iterations"] / max(totals["solves"], 1),
         "osqp_iteration_cap_hits": totals["max_iter_hits"],
+        "rescued_qps": totals["rescues"] - totals["rescue_failures"],  # cap hits solved by a fresh solver (SparseQP._rescue)
+        "rescue_failures": totals["rescue_failures"],
         "unpolished_qps": totals["unpolished"],
         "refined_qps": totals["refined"],  # polishing failed, continued to osqp_refine_eps (when set)
+        "refine_capped": totals["refine_capped"],  # ... whose refinement stopped at its cap, closer than the first pass
         "refine_fallbacks": totals["refine_fallbacks"],
         "goal_env_steps_per_s": steps / t_env,
     }
@@ -120,11 +125,14 @@ def main() -> None:
     parser.add_argument("--accuracy", type=int, default=200, help="QPs checked against a tight reference (N = 20)")
     parser.add_argument("--osqp-eps", type=float, default=None, help="override PlannerConfig.osqp_eps (default: the robot's config)")
     parser.add_argument("--osqp-rho", type=float, default=None, help="override PlannerConfig.osqp_rho")
-    parser.add_argument("--osqp-refine-eps", type=float, default=None, help="override PlannerConfig.osqp_refine_eps")
+    parser.add_argument("--osqp-refine-eps", type=float, default=None, help="override PlannerConfig.osqp_refine_eps (0: no refinement)")
+    parser.add_argument("--osqp-refine-max-iter", type=int, default=None, help="override PlannerConfig.osqp_refine_max_iter")
     parser.add_argument("--sizes", default="20,30", help="band sizes N to measure, comma-separated")
     args = parser.parse_args()
-    overrides = {k: v for k, v in (("osqp_eps", args.osqp_eps), ("osqp_rho", args.osqp_rho), ("osqp_refine_eps", args.osqp_refine_eps))
-                 if v is not None}
+    overrides = {k: v for k, v in (("osqp_eps", args.osqp_eps), ("osqp_rho", args.osqp_rho), ("osqp_refine_eps", args.osqp_refine_eps),
+                                          ("osqp_refine_max_iter", args.osqp_refine_max_iter)) if v is not None}
+    if overrides.get("osqp_refine_eps") == 0:
+        overrides["osqp_refine_eps"] = None
     result = {
         f"{robot}_N{n}": bench(robot, n, args.calls, args.accuracy if n == 20 else 0, **overrides)
         for robot in ("jackal", "turtlebot2") for n in (int(x) for x in args.sizes.split(","))

@@ -1,5 +1,7 @@
 """SparseQP (the planner's direct use of the compiled OSQP solver) against OSQP's public interface."""
 
+from pathlib import Path
+
 import numpy as np
 import osqp
 import scipy.sparse as sp
@@ -106,3 +108,25 @@ def test_refinement_makes_unpolished_solutions_accurate():
     assert plain.stats.unpolished >= 2 and refined.stats.refined == plain.stats.unpolished
     assert refined.stats.refine_fallbacks == 0
     assert max(errors_refined) < 1e-5 < max(errors_plain)
+
+
+def test_a_stalled_solve_is_rescued_by_a_fresh_solver():
+    """A QP recorded from the planner (Jackal, N = 20, a turn-around band) on which OSQP's ADMM
+    stalls: 4,000 iterations without reaching eps 1e-3 from a fresh start with the planner's
+    settings. ``SparseQP`` counts the cap hit and solves it again with a solver that adapts its step
+    size more often; the answer is polished and feasible. Without the rescue the solve fails."""
+    d = np.load(Path(__file__).parent / "data" / "planner_stalling_qp.npz")
+    m, n = len(d["lower"]), len(d["q"])
+    args = (n, m, d["P_data"], (d["P_indices"], d["P_indptr"]), (d["A_indices"], d["A_indptr"]))
+    A = sp.csc_matrix((d["A_data"], d["A_indices"], d["A_indptr"]), shape=(m, n))
+
+    qp = SparseQP(*args, eps=1e-3, max_iter=4000, rho=0.1)
+    assert qp.solve(d["A_data"], d["q"], d["lower"], d["upper"]) == SOLVED
+    assert qp.stats.max_iter_hits == 1 and qp.stats.rescues == 1 and qp.stats.rescue_failures == 0
+    assert qp.stats.unpolished == 0  # the rescue's answer was confirmed by polishing
+    Ax = A @ qp.x
+    assert np.all(Ax >= d["lower"] - 1e-6) and np.all(Ax <= d["upper"] + 1e-6)
+
+    plain = SparseQP(*args, eps=1e-3, max_iter=4000, rho=0.1)
+    plain._rescue = lambda *a: plain._wrapper  # the capped first pass stands
+    assert plain.solve(d["A_data"], d["q"], d["lower"], d["upper"]) == FAILED

@@ -20,6 +20,7 @@ SOLVED = "solved"
 PRIMAL_INFEASIBLE = "primal_infeasible"
 FAILED = "failed"
 
+RESCUE_RHO_INTERVAL = 25  # ADMM iterations between step-size updates in a rescue solve (OSQP's default here: 50)
 _SOLVED = {osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE}
 _INFEASIBLE = {osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE, osqp.SolverStatus.OSQP_PRIMAL_INFEASIBLE_INACCURATE}
 
@@ -35,7 +36,10 @@ class QPStats:
     inaccurate: int = 0
     unpolished: int = 0  # after the refinement pass, where one ran
     refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
-    refine_fallbacks: int = 0  # ... whose refinement stopped at its iteration cap (the first pass's solution kept)
+    rescues: int = 0  # solves that hit the cap, solved again by a fresh solver (``SparseQP._rescue``)
+    rescue_failures: int = 0  # ... which did not solve it either (the solve failed)
+    refine_capped: int = 0  # ... whose refinement stopped at its cap with smaller residuals than the first pass (kept)
+    refine_fallbacks: int = 0  # ... whose refinement failed or stopped at its cap no better (the first pass's solution kept)
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -47,7 +51,7 @@ class SparseQP:
     pattern's order), q, l and u. OSQP warm-starts from the previous solution until ``restart``
     (only iterations change: every solve runs to ``eps`` and is then polished). With ``refine_eps``,
     a solution whose polishing failed is continued to that tolerance and polished again (at most
-    ``refine_max_iter`` more iterations; at the cap the first solution stands)."""
+    ``refine_max_iter`` more iterations; at the cap the iterate with the smaller residuals stands)."""
 
     def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int,
                  rho: float = 0.1, refine_eps: float | None = None, refine_max_iter: int = 1000):
@@ -94,13 +98,37 @@ class SparseQP:
             self._solver.update_data_vec(q=q, l=lower, u=upper)
             self._solver.update_data_mat(P_x=None, P_i=None, A_x=A_values, A_i=None)
         self._solver.solve()
-        info = self._solver.info
-        status = info.status_val
         stats = self.stats
         stats.solves += 1
-        stats.osqp_iterations += int(info.iter)
-        if status == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
+        stats.osqp_iterations += int(self._solver.info.iter)
+        wrapper = self._wrapper
+        if self._solver.info.status_val == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
             stats.max_iter_hits += 1
+            wrapper = self._rescue(A_values, q, lower, upper)
+        status = self._accept(wrapper)
+        if wrapper is not self._wrapper and status == SOLVED:  # the main solver goes on from the rescue's solution
+            self._solver.warm_start(x=self.x, y=np.array(wrapper._solver.solution.y, dtype=float))
+        return status
+
+    def _rescue(self, A_values, q, lower, upper):
+        """The iteration cap was hit (rare: ADMM's step size can cycle on a badly conditioned QP).
+        The same QP is solved once more by a fresh solver that adapts its step size twice as often
+        (``RESCUE_RHO_INTERVAL``); returns that solver, whose outcome counts instead."""
+        self.stats.rescues += 1
+        rescue = osqp.OSQP()
+        rescue.setup(self._P, q, sp.csc_matrix((A_values, *self._A_pattern), shape=(self.m, self.n)), lower, upper,
+                     **dict(self._settings, adaptive_rho_interval=RESCUE_RHO_INTERVAL))
+        rescue._solver.solve()
+        self.stats.osqp_iterations += int(rescue._solver.info.iter)
+        if rescue._solver.info.status_val not in _SOLVED:
+            self.stats.rescue_failures += 1
+        return rescue
+
+    def _accept(self, wrapper) -> str:
+        """Read the solve's outcome off ``wrapper``'s solver into ``x`` (refined where asked); the status."""
+        info = wrapper._solver.info
+        status = info.status_val
+        stats = self.stats
         if status == osqp.SolverStatus.OSQP_SOLVED_INACCURATE:
             stats.inaccurate += 1
         refine = info.status_polish != 1 and self._refine_eps is not None and status in _SOLVED
@@ -110,29 +138,38 @@ class SparseQP:
             return PRIMAL_INFEASIBLE
         if status not in _SOLVED:
             return FAILED
-        self.x = np.array(self._solver.solution.x, dtype=float)
+        self.x = np.array(wrapper._solver.solution.x, dtype=float)
         if refine:
-            self._refine()
+            self._refine(wrapper)
         if not np.all(np.isfinite(self.x)):
             return FAILED
         return SOLVED
 
-    def _refine(self) -> None:
+    def _refine(self, wrapper) -> None:
         stats = self.stats
         stats.refined += 1
-        self._wrapper.update_settings(eps_abs=self._refine_eps, eps_rel=self._refine_eps, max_iter=self._refine_max_iter)
+        solver = wrapper._solver
+        first_residual = max(solver.info.prim_res, solver.info.dual_res)
+        wrapper.update_settings(eps_abs=self._refine_eps, eps_rel=self._refine_eps, max_iter=self._refine_max_iter)
         try:
-            self._solver.solve()  # from the first pass's iterate
-            info = self._solver.info
+            solver.solve()  # from the first pass's iterate
+            info = solver.info
             stats.osqp_iterations += int(info.iter)
             if info.status_val in _SOLVED:
-                x = np.array(self._solver.solution.x, dtype=float)
+                x = np.array(solver.solution.x, dtype=float)
                 if np.all(np.isfinite(x)):
                     self.x = x
                 stats.unpolished += info.status_polish != 1
+            elif (info.status_val == osqp.SolverStatus.OSQP_MAX_ITER_REACHED
+                  and max(info.prim_res, info.dual_res) < first_residual
+                  and np.all(np.isfinite(x := np.array(solver.solution.x, dtype=float)))):
+                # stopped at the cap, but closer to optimal than the first pass: the better iterate stands
+                self.x = x
+                stats.refine_capped += 1
+                stats.unpolished += 1
             else:
                 stats.refine_fallbacks += 1
                 stats.unpolished += 1
         finally:
             settings = self._settings
-            self._wrapper.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"], max_iter=settings["max_iter"])
+            wrapper.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"], max_iter=settings["max_iter"])

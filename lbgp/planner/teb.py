@@ -195,6 +195,8 @@ class TebPlanner:
             name = candidates.pop(0)
             if name != "keep" and self._over_budget(t_start, iterations):
                 break
+            if name != "keep":
+                self._qp.restart()  # each band from a fresh start: a warm start from another band can stall OSQP
             v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             lower = self._forward_only(problem) if name == "turn" else self._u_lo  # turning around: forwards only

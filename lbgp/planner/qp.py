@@ -35,9 +35,9 @@ class QPStats:
     max_iter_hits: int = 0
     inaccurate: int = 0
     unpolished: int = 0  # after the refinement pass, where one ran
-    refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
     rescues: int = 0  # solves that hit the cap, solved again by a fresh solver (``SparseQP._rescue``)
     rescue_failures: int = 0  # ... which did not solve it either (the solve failed)
+    refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
     refine_capped: int = 0  # ... whose refinement stopped at its cap with smaller residuals than the first pass (kept)
     refine_fallbacks: int = 0  # ... whose refinement failed or stopped at its cap no better (the first pass's solution kept)
 

@@ -25,7 +25,7 @@ up once, every later solve only updates values.
 No hidden state: every call starts from the same deterministic first guess (a pursuit of the
 moving goal within the limits, ``pursuit_commands``), and OSQP starts each call as a fresh solver
 would (x = y = 0, the initial rho; its warm start only carries from one QP to the next within a
-call), so the command is a function of (robot pose and velocity, person pose and velocity, goal)
+candidate band, and every band starts afresh), so the command is a function of (robot pose and velocity, person pose and velocity, goal)
 alone, exactly: where two candidate bands score alike, solver noise cannot tip the choice.
 Local minima (TEB's remedy: bands in distinct topologies): for a goal that will still be behind
 the robot at the end of the horizon, a forwards-only band that turns the robot around is solved

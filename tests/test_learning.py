@@ -11,8 +11,10 @@ down for seed 2).
 
 Measured (`python benchmarks/learning_seeds.py --seeds 0,1,2,3`, results/learning_seeds.json;
 straight_ahead return, 35 steps, as judged here; the paper's plain actor with the goal prior,
-`D4PGConfig.paper(prior_weight=1)`): trained 23.8 / 24.4 / 24.4 / 24.0 for seeds 0-3, untrained
--0.8 / 9.2 / 4.3 / 2.8, random policy 1.0: the bounds below hold for all four seeds. For scale, a
+`D4PGConfig.paper(prior_weight=1)`; with the planner's QP refinement, 2026-12-02): trained 25.0 /
+25.7 / 25.9 / 24.4 for seeds 0-3, untrained -0.8 / 9.2 / 4.4 / 2.8, random policy 3.7 (before the
+refinement: 23.8 / 24.4 / 24.4 / 24.0, -0.8 / 9.2 / 4.3 / 2.8, 1.0): the bounds below hold for all
+four seeds. For scale, a
 constant goal 1.5 m ahead scores ~25 (and is exactly where the default residual actor starts).
 """
 

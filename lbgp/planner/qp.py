@@ -62,7 +62,7 @@ class SparseQP:
         self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter,
                               rho=self._rho)
         # a solve whose active set polishing did not confirm continues (warm) to refine_eps and is
-        # polished again; if that pass hits its cap, the first pass's solution stands
+        # polished again; if that pass hits its cap, the iterate with the smaller residuals stands
         self._refine_eps, self._refine_max_iter = refine_eps, refine_max_iter
         self._solver = None
         self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite

@@ -25,8 +25,8 @@ up once, every later solve only updates values.
 No hidden state: every call starts from the same deterministic first guess (a pursuit of the
 moving goal within the limits, ``pursuit_commands``), and OSQP starts each call as a fresh solver
 would (x = y = 0, the initial rho; its warm start only carries from one QP to the next within a
-candidate band, and every band starts afresh), so the command is a function of (robot pose and velocity, person pose and velocity, goal)
-alone, exactly: where two candidate bands score alike, solver noise cannot tip the choice.
+candidate band, and every band starts afresh), so the command is a function of (robot pose and
+velocity, person pose and velocity, goal) alone, exactly: where two candidate bands score alike, solver noise cannot tip the choice.
 Local minima (TEB's remedy: bands in distinct topologies): for a goal that will still be behind
 the robot at the end of the horizon, a forwards-only band that turns the robot around is solved
 beside the one that may back up; when the band passes near the person's predicted path, one that
@@ -186,7 +186,6 @@ class TebPlanner:
             goal_yaw=goal_yaw,
             person_path=person_path,
         )
-        self._qp.restart()  # no state from earlier calls: the same input gives the same QPs, solved the same way
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_off_heading(problem):
             candidates.append("turn")
@@ -195,8 +194,9 @@ class TebPlanner:
             name = candidates.pop(0)
             if name != "keep" and self._over_budget(t_start, iterations):
                 break
-            if name != "keep":
-                self._qp.restart()  # each band from a fresh start: a warm start from another band can stall OSQP
+            # every band from a fresh start: no state from earlier calls or from the band before (the same
+            # input gives the same QPs, solved the same way; a warm start from another band can stall OSQP)
+            self._qp.restart()
             v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             lower = self._forward_only(problem) if name == "turn" else self._u_lo  # turning around: forwards only

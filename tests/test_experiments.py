@@ -2,6 +2,7 @@
 pictures, the ablation figure."""
 
 import csv
+import dataclasses
 import json
 import shutil
 
@@ -240,3 +241,22 @@ def test_ablation_final_returns_summarise_each_variant_over_its_seeds():
     assert out["A"]["mean"] == 2.0 and out["A"]["per_seed"] == [1.0, 3.0]
     assert abs(out["A"]["ci95_half_width"] - 12.706) < 1e-3  # t(0.975, 1) * sqrt(2) / sqrt(2)
     assert out["B"] == {"per_seed": [5.0], "mean": 5.0, "ci95_half_width": None}
+
+
+def test_a_kept_run_made_before_a_setting_existed_is_reused_at_that_settings_default(tmp_path):
+    """The archived configs predate later settings (mirror_augment, turn_lead): a key missing from
+    a kept config reads as its default, the behaviour from before it existed; a kept value that
+    differs from the asked one is still another run."""
+    from lbgp.experiments.ablation import ARCHIVED_FILES, archived_run, variant_config
+
+    cfg = variant_config("LBGP", 0, 30.0)
+    old = json.loads(cfg.to_json())
+    del old["mirror_augment"], old["turn_lead"]
+    for name in ARCHIVED_FILES:
+        (tmp_path / name).write_text("{}")
+    (tmp_path / "config.json").write_text(json.dumps(old))
+    (tmp_path / "summary.json").write_text(json.dumps({"env_steps": 7}))
+    assert archived_run(tmp_path, cfg) == {"env_steps": 7}
+    assert archived_run(tmp_path, dataclasses.replace(cfg, turn_lead=0.4)) is None
+    (tmp_path / "config.json").write_text(json.dumps({**old, "not_a_setting": 1}))
+    assert archived_run(tmp_path, cfg) is None

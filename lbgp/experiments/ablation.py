@@ -51,7 +51,10 @@ def archived_run(archive: Path, cfg: D4PGConfig) -> dict | None:
     try:
         if not all((archive / name).is_file() for name in ARCHIVED_FILES):
             return None
-        if json.loads((archive / "config.json").read_text()) != json.loads(cfg.to_json()):
+        # a setting added after the run was made is read at its default, which every new setting
+        # takes as the behaviour from before it existed (e.g. mirror_augment False, turn_lead 0)
+        kept = D4PGConfig.from_dict(json.loads((archive / "config.json").read_text()))
+        if json.loads(kept.to_json()) != json.loads(cfg.to_json()):
             return None
         return json.loads((archive / "summary.json").read_text())
     except (OSError, ValueError):

@@ -100,7 +100,7 @@ def cmd_train(args) -> int:
             method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
         )
-        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "max_updates_per_step": args.updates_per_step,
+        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
                  "mirror_augment": True if args.mirror_augment else None}
         if args.randomize:
             from lbgp.dynamics import load_randomization
@@ -356,6 +356,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--actors", type=A.positive_int, default=None, help="actor processes, one of them exploits (default 2: one per core beside the learner's on 2 cores)")
     p.add_argument("--prior-weight", type=A.nonnegative_float, default=None,
                    help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; --paper: 0)")
+    p.add_argument("--turn-lead", type=A.nonnegative_float, default=None, metavar="M_PER_RAD_S",
+                   help="LBGP: a turn-aware base goal, this much farther ahead per rad/s of the person's turn rate (default 0: 1.5 m ahead)")
     p.add_argument("--updates-per-step", type=A.positive_float, default=None,
                    help="the learner's updates per collected env step at most (default 2; --paper: 1)")
     p.add_argument("--randomize", type=A.randomize_spec, default=None, metavar="PRESET|FILE",

@@ -107,3 +107,14 @@ def test_train_mirror_augment_flag_reaches_the_run_config(tmp_path):
     run = tmp_path / "run"
     assert main(["train", "--mirror-augment", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
     assert json.loads((run / "config.json").read_text())["mirror_augment"] is True
+
+
+def test_train_turn_lead_reaches_the_run_config_and_the_policy_file(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["train", "--turn-lead", "0.4", "--paper", "--out", str(run)]) == 2
+    assert "turn_lead" in capsys.readouterr().err and not run.exists()  # the paper's actor has no base goal
+    assert main(["train", "--turn-lead", "0.4", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    assert json.loads((run / "config.json").read_text())["turn_lead"] == 0.4
+    from lbgp.agent.policy import load_policy
+
+    assert load_policy(run / "policy.pt").actor.turn_lead == 0.4

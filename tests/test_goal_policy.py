@@ -180,3 +180,69 @@ def test_mirror_averaged_acting_is_exactly_mirror_equivariant_for_every_kind_of_
             np.testing.assert_allclose(averaged.act(o), 0.5 * (own + mirror_action(of_mirror)), atol=1e-6)
             np.testing.assert_allclose(averaged.act(obs_lib.mirror(o)), mirror_action(averaged.act(o)), atol=1e-6)
             np.testing.assert_allclose(raw.act(o), actor(torch.from_numpy(o)[None])[0].detach().numpy(), atol=1e-6)
+
+
+def _turning_observation(turn_rate: float, speed: float = 0.8) -> np.ndarray:
+    """The noise-free observation of a person walking an arc at ``turn_rate`` with the robot 1.5 m ahead."""
+    stack = obs_lib.ObservationStack()
+    x = y = th = 0.0
+    for k in range(obs_lib.FRAMES + 2):
+        person = np.array([x, y, th])
+        robot = person + [1.5 * math.cos(th), 1.5 * math.sin(th), 0.0]
+        stack.reset(robot, person) if k == 0 else stack.push(robot, person)
+        x, y = x + speed * obs_lib.FRAME_PERIOD * math.cos(th), y + speed * obs_lib.FRAME_PERIOD * math.sin(th)
+        th += turn_rate * obs_lib.FRAME_PERIOD
+    return stack.vector()
+
+
+@pytest.mark.parametrize("turn_rate", [-0.6, -0.3, 0.0, 0.25, 0.5])
+def test_turn_rate_estimate_reads_the_persons_turn_from_the_observation(turn_rate):
+    obs = _turning_observation(turn_rate)
+    w = obs_lib.turn_rate_weights()
+    assert float(obs @ w) == pytest.approx(turn_rate, abs=1e-5)
+    assert float(obs_lib.mirror(obs) @ w) == pytest.approx(-turn_rate, abs=1e-5)
+    assert float(torch.from_numpy(obs) @ torch.from_numpy(w)) == pytest.approx(turn_rate, abs=1e-5)
+    with pytest.raises(ValueError, match="past frames"):
+        obs_lib.turn_rate_weights(obs_lib.FRAMES)
+
+
+def test_turn_aware_base_moves_the_goal_ahead_by_the_lead_times_the_turn_rate(tmp_path):
+    """An untrained actor with ``turn_lead`` gives the goal 1.5 m + lead * |turn rate| ahead, the same
+    for either turn direction; the goal prior pulls toward that base (zero for the untrained actor),
+    and a policy file keeps the lead (its dead band shrinks toward the observation's own base)."""
+    cfg = D4PGConfig(hidden=(8,), turn_lead=0.4)
+    actor = make_actor(cfg, obs_lib.SIZE, 2)
+    obs = torch.from_numpy(np.stack([_turning_observation(w) for w in (0.0, 0.3, -0.3, 0.5)]))
+    with torch.no_grad():
+        goals = np.array([goal_from_action(a) for a in actor(obs).numpy()])
+    assert np.allclose(goals, [[1.5, 0.0], [1.62, 0.0], [1.62, 0.0], [1.7, 0.0]], atol=1e-4)
+    assert np.allclose(make_actor(D4PGConfig(hidden=(8,)), obs_lib.SIZE, 2)(obs).detach().numpy(),
+                       action_from_goal(DESIRED_GOAL), atol=1e-6)  # no lead: the goal ahead whatever the turn
+
+    learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
+    with torch.no_grad():  # a residual 0.12 m short of the base for every observation: 0.06 in action units
+        learner.actor.net[-1].bias.copy_(torch.tensor([math.atanh(-0.12 / 0.75), 0.0]))
+        loss, q = learner.actor_loss(obs)
+    # the prior is measured from each observation's own base (from the goal 1.5 m ahead, the
+    # turning observations' goals would be 0, 0 and 0.08 m off instead)
+    assert float(loss + q.mean()) == pytest.approx(0.06 ** 2, abs=1e-6)
+
+    with torch.no_grad():  # a residual 0.05 m ahead, inside the dead band, whatever the observation
+        actor.net[-1].bias.copy_(torch.tensor([math.atanh(0.05 / 0.75), 0.0]))
+    save_policy(tmp_path / "t.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
+    policy = load_policy(tmp_path / "t.pt")
+    assert policy.actor.turn_lead == pytest.approx(0.4)
+    acted = np.array([goal_from_action(policy.act(o)) for o in obs.numpy()])
+    assert np.allclose(acted, [[1.5, 0.0], [1.62, 0.0], [1.62, 0.0], [1.7, 0.0]], atol=1e-4)
+    raw = np.array([goal_from_action(load_policy(tmp_path / "t.pt", goal_deadband=0.0).act(o)) for o in obs.numpy()])
+    assert np.allclose(raw - acted, [[0.05, 0.0]] * 4, atol=1e-4)
+
+
+def test_turn_lead_needs_a_residual_actor():
+    with pytest.raises(ValueError, match="turn_lead"):
+        D4PGConfig.paper(turn_lead=0.4).validate()
+    with pytest.raises(ValueError, match="turn_lead"):
+        D4PGConfig(turn_lead=-0.1).validate()
+    with pytest.raises(ValueError, match="turn_lead"):
+        Actor(obs_lib.SIZE, 2, (8,), turn_lead=0.4)
+    assert make_actor(D4PGConfig(method="e2e", turn_lead=0.4), obs_lib.SIZE, 2).turn_lead == 0.0

@@ -64,6 +64,8 @@ class D4PGConfig:
     residual_scale: float = 0.375  # > 0: the actor outputs the goal 1.5 m ahead plus a residual bounded by
     # this (action units: 0.375 = 0.75 m), its last layer initialised to zero; 0 = the paper's plain actor.
     # E2E: always plain.
+    turn_lead: float = 0.0  # m per rad/s: the residual's base goal moves this much farther ahead per
+    # rad/s of the person's turn rate seen in the observation (a turn-aware base); 0 = the goal 1.5 m ahead
     normalize_obs: bool = True  # standardise the observation (mean/std of the first min_replay transitions)
     randomize: dict = dataclasses.field(default_factory=dict)  # domain randomisation ranges per episode
     # (lbgp.dynamics.Randomization as a dict; `lbgp train --randomize PRESET|FILE` fills it); {}: none
@@ -101,6 +103,10 @@ class D4PGConfig:
             raise ValueError(f"noise_correlation must be in [0, 1), got {self.noise_correlation}")
         if not 0.0 <= self.residual_scale <= 2.0:
             raise ValueError(f"residual_scale must be in [0, 2], got {self.residual_scale}")
+        if not 0.0 <= self.turn_lead <= 5.0:
+            raise ValueError(f"turn_lead must be in [0, 5] m per rad/s, got {self.turn_lead}")
+        if self.turn_lead > 0 and self.residual_scale == 0:
+            raise ValueError("turn_lead moves a residual actor's base goal: it needs residual_scale > 0 (not --paper)")
         if not self.max_updates_per_step > 0:
             raise ValueError(f"max_updates_per_step must be > 0, got {self.max_updates_per_step}")
         if not self.prior_weight >= 0:
@@ -113,7 +119,7 @@ class D4PGConfig:
     def paper(cls, **overrides) -> "D4PGConfig":
         """The paper's plain configuration (`lbgp train --paper`): tanh actor on the raw observation,
         no goal prior, uniform spawns, white exploration noise of 0.3, batch 128, one update per step."""
-        plain = dict(residual_scale=0.0, normalize_obs=False, spawn_front_share=0.5, noise_correlation=0.0,
+        plain = dict(residual_scale=0.0, turn_lead=0.0, normalize_obs=False, spawn_front_share=0.5, noise_correlation=0.0,
                      sigma=0.3, prior_weight=0.0, batch_size=128, max_updates_per_step=1.0,
                      actor_warmup_updates=0)
         return cls(**{**plain, **overrides})

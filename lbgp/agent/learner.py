@@ -16,7 +16,8 @@ from lbgp.agent.networks import Actor, DistributionalCritic
 def make_actor(cfg: D4PGConfig, obs_size: int, action_size: int) -> Actor:
     """The actor a config asks for (the learner's and every actor process's)."""
     base = action_from_goal(DESIRED_GOAL) if cfg.actor_residual_scale > 0 else None
-    return Actor(obs_size, action_size, cfg.hidden, residual_scale=cfg.actor_residual_scale, base=base)
+    return Actor(obs_size, action_size, cfg.hidden, residual_scale=cfg.actor_residual_scale, base=base,
+                 turn_lead=cfg.turn_lead if cfg.actor_residual_scale > 0 else 0.0)
 
 
 class D4PGLearner:
@@ -29,7 +30,8 @@ class D4PGLearner:
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
         self.updates = 0
-        # LBGP's goal prior (cfg.prior_weight): the goal 1.5 m straight ahead of the person
+        # LBGP's goal prior (cfg.prior_weight): a residual actor's base (the goal 1.5 m straight ahead
+        # of the person, turn-aware with cfg.turn_lead), a plain actor's the goal ahead
         self.prior = torch.as_tensor(action_from_goal(DESIRED_GOAL), dtype=torch.float32)
         self.prior_weight = cfg.prior_weight if cfg.method == "lbgp" else 0.0
         self.obs_stats_set = not cfg.normalize_obs  # nothing to set when inputs are not standardised
@@ -80,7 +82,8 @@ class D4PGLearner:
         q = self.critic.q_value(obs, action)
         loss = -q.mean()
         if self.prior_weight > 0:
-            loss = loss + self.prior_weight * ((action - self.prior) ** 2).sum(-1).mean()
+            prior = self.actor.base_action(obs) if self.actor.residual_scale > 0 else self.prior
+            loss = loss + self.prior_weight * ((action - prior) ** 2).sum(-1).mean()
         return loss, q
 
     def state_dict(self) -> dict:

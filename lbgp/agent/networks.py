@@ -12,12 +12,20 @@ The actor has two output forms:
 * residual (``residual_scale > 0``, LBGP's default): ``a = base + residual_scale * tanh(net(obs))``,
   clipped to [-1, 1], with the last layer initialised to zero, so that an untrained actor gives
   exactly the ``base`` action (the goal 1.5 m ahead) and learning only has to find where to deviate.
+  With ``turn_lead > 0`` the base is turn-aware: the goal ahead moves ``turn_lead`` metres farther
+  per rad/s of the person's turn rate as the observation shows it
+  (``lbgp.sim.observation.turn_rate_weights``), because a robot tracking a goal around a turning
+  person falls behind it (docs/training.md).
 """
 
 from __future__ import annotations
 
+import numpy as np
 import torch
 from torch import nn
+
+from lbgp.actions import GOAL_X
+from lbgp.sim.observation import turn_rate_weights
 
 MIN_OBS_STD = 0.01  # floor of the standardisation's std (scaled units: 6 cm, 1.8 deg): pure-noise
 # dimensions are not blown up
@@ -52,7 +60,8 @@ class Standardizer(nn.Module):
 class Actor(nn.Module):
     """Deterministic policy: observation -> action in [-1, 1]^action_size."""
 
-    def __init__(self, obs_size: int, action_size: int, hidden=(256, 256), residual_scale: float = 0.0, base=None):
+    def __init__(self, obs_size: int, action_size: int, hidden=(256, 256), residual_scale: float = 0.0, base=None,
+                 turn_lead: float = 0.0):
         super().__init__()
         self.norm = Standardizer(obs_size)
         self.net = mlp([obs_size, *hidden], action_size)
@@ -60,15 +69,34 @@ class Actor(nn.Module):
         if not 0.0 <= self.residual_scale <= 2.0:
             raise ValueError(f"residual_scale must be in [0, 2], got {residual_scale}")
         self.register_buffer("base", torch.zeros(action_size) if base is None else torch.as_tensor(base, dtype=torch.float32).reshape(action_size))
+        self.turn_lead = float(turn_lead)  # m of goal distance per rad/s of the person's turn rate
+        if not (np.isfinite(self.turn_lead) and 0.0 <= self.turn_lead <= 5.0):
+            raise ValueError(f"turn_lead must be in [0, 5] m per rad/s, got {turn_lead}")
+        if self.turn_lead > 0 and (self.residual_scale == 0 or action_size != 2):
+            raise ValueError("turn_lead needs a residual goal actor (residual_scale > 0, 2 outputs)")
+        # obs @ lead = the base goal's extra x in action units (x action = 2 (x - GOAL_X[0]) / span - 1)
+        lead = np.zeros((obs_size, 1), np.float32)
+        if self.turn_lead > 0:
+            lead[:, 0] = turn_rate_weights() * self.turn_lead * 2.0 / (GOAL_X[1] - GOAL_X[0])
+        self.register_buffer("_lead", torch.from_numpy(lead), persistent=False)
         if self.residual_scale > 0:
             last = self.net[-1]
             nn.init.zeros_(last.weight)
             nn.init.zeros_(last.bias)
 
+    def base_action(self, obs: torch.Tensor) -> torch.Tensor:
+        """The residual's base for each observation (batch, action_size): ``base``, its goal moved
+        ahead by ``turn_lead`` * |turn rate| when that is set."""
+        base = self.base.expand(*obs.shape[:-1], self.base.shape[0])
+        if self.turn_lead == 0:
+            return base
+        shift = torch.abs(obs @ self._lead)  # (..., 1)
+        return base + torch.cat([shift, torch.zeros_like(shift)], dim=-1)
+
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         out = torch.tanh(self.net(self.norm(obs)))
         if self.residual_scale > 0:
-            return torch.clamp(self.base + self.residual_scale * out, -1.0, 1.0)
+            return torch.clamp(self.base_action(obs) + self.residual_scale * out, -1.0, 1.0)
         return out
 
     def set_obs_stats(self, mean: torch.Tensor, std: torch.Tensor) -> None:

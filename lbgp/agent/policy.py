@@ -37,8 +37,8 @@ from lbgp.agent.networks import Actor
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
-VERSION = 2  # 2: input standardisation buffers and the residual goal form (version 1 files still load)
-READABLE = (1, 2)
+VERSION = 3  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base
+READABLE = (1, 2, 3)
 GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
 MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
@@ -85,7 +85,9 @@ class Policy:
         else:
             action = self.actor(torch.from_numpy(obs)[None])[0].numpy()
         if self.goal_deadband > 0.0:
-            return shrink_residual(action, self.actor.base.numpy(), self.goal_deadband)
+            # the base of the observation and of its mirror image agree (it has no lateral part)
+            base = self.actor.base_action(torch.from_numpy(obs)[None])[0].numpy()
+            return shrink_residual(action, base, self.goal_deadband)
         return action
 
 
@@ -101,6 +103,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "action_size": 2,
             "hidden": list(hidden),
             "residual_scale": float(residual_scale),
+            "turn_lead": float(actor.turn_lead),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },
@@ -125,7 +128,7 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bo
     expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
         actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]),
-                      residual_scale=float(data.get("residual_scale", 0.0)))
+                      residual_scale=float(data.get("residual_scale", 0.0)), turn_lead=float(data.get("turn_lead", 0.0)))
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}
         weights = dict(data["actor"])
         if data["version"] == 1:  # no standardisation, plain actor: identity buffers

@@ -119,6 +119,23 @@ def mirror(obs: np.ndarray) -> np.ndarray:
     return obs * _MIRROR
 
 
+TURN_RATE_FRAMES = 5  # past person frames (1 s) in the turn-rate estimate below
+
+
+def turn_rate_weights(frames: int = TURN_RATE_FRAMES) -> np.ndarray:
+    """Weights w with ``obs @ w`` = the person's turn rate (rad/s, left positive) seen in a scaled
+    observation: the least-squares slope, through the origin, of the person's past headings in the
+    current person frame (a person turning at omega was heading -omega * i * FRAME_PERIOD i frames
+    ago) over the last ``frames`` frames. Linear in the observation, so it works on numpy arrays and
+    torch tensors alike, one observation or a batch; the mirror image's turn rate is its negative."""
+    if not 1 <= frames < FRAMES:
+        raise ValueError(f"the turn-rate estimate uses 1 to {FRAMES - 1} past frames, got {frames}")
+    i = np.arange(1, frames + 1, dtype=float)
+    w = np.zeros(SIZE)
+    w[3 + 6 * (i.astype(int) - 1) + 2] = -i * ANGLE_SCALE / (np.sum(i * i) * FRAME_PERIOD)
+    return w.astype(np.float32)
+
+
 def unscale(obs: np.ndarray) -> np.ndarray:
     """Metric relative states back from a (noise-free, unclipped) observation vector."""
     return (np.asarray(obs, dtype=float).reshape(-1, 3) / _INV_SCALE).ravel()

@@ -25,6 +25,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
 from ablation_scenarios import score  # noqa: E402
+from goal_ceiling import TRAJECTORIES, TURNING  # noqa: E402
 
 from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.learner import make_actor  # noqa: E402
@@ -32,8 +33,7 @@ from lbgp.agent.policy import save_policy  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
-GROUPS = {"turning": ("turning_ahead", "turning_behind", "turning_inside", "turning_outside"),
-          "trajectories": ("trajectory_one", "trajectory_two", "trajectory_three")}
+GROUPS = {"turning": TURNING, "trajectories": TRAJECTORIES}
 
 
 def untrained_policy_file(folder: Path, lead: float) -> Path:

@@ -42,6 +42,7 @@ import numpy as np  # noqa: E402
 from lbgp.agent.policy import GOAL_DEADBAND_M, MIRROR_AVERAGE  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
+from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
@@ -80,12 +81,15 @@ def acting_run_name(run: str, deadband: float | None = None, mirror: bool = MIRR
     return f"{variant_of(run)}{tags}_s{seed_of(run)}" if tags else run
 
 
-def score(job: tuple[str, str, str | None, list[str], int, int, float | None, bool]) -> tuple[str, dict]:
-    name, method, policy_file, scenarios, episodes, seed, deadband, mirror = job
+def score(job: tuple) -> tuple[str, dict]:
+    """job: (name, method, policy_file, scenarios, episodes, seed, deadband, mirror[, planner_changes]);
+    ``planner_changes``: PlannerConfig fields to change from the Jackal's preset (default none)."""
+    name, method, policy_file, scenarios, episodes, seed, deadband, mirror, *rest = job
+    planner = planner_config_for("jackal").with_(**rest[0]) if rest and rest[0] else None
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
     # scenario k's episodes seeded as lbgp experiment sim seeds them: its rows are the same episodes
     rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * scenario_names().index(name),
-                     obs_noise=True)[0] for name in scenarios]
+                     obs_noise=True, planner_config=planner)[0] for name in scenarios]
     per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
                   "mirror_average": getattr(policy, "mirror_average", None), "per_scenario": per_scenario,

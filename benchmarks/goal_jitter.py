@@ -42,10 +42,11 @@ class JitteredGoal:
         return action_from_goal(goal).astype(np.float32)
 
 
-def jitter_rewards(robot: str = "jackal", std: float = 0.1, episodes: int = 5, scenarios=TURNING) -> dict:
+def jitter_rewards(robot: str = "jackal", std: float = 0.1, episodes: int = 5, scenarios=TURNING, planner_config=None) -> dict:
+    """HC's reward with and without goal jitter (``planner_config``: default the robot's preset)."""
     rows = {}
     for scenario in scenarios:
-        env = make_env(scenario, robot=robot, seed=0)
+        env = make_env(scenario, robot=robot, seed=0, planner_config=planner_config)
         clean = run_episode(env, make_policy("hc")).total_reward  # scenarios are noise-free: one episode
         noisy = [run_episode(env, JitteredGoal(make_policy("hc"), std, seed)).total_reward for seed in range(episodes)]
         rows[scenario] = {"clean": clean, "noisy_mean": float(np.mean(noisy)), "noisy": noisy}

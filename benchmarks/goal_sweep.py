@@ -31,11 +31,12 @@ XS = np.round(np.arange(1.0, 2.2 + 1e-9, 0.05), 2)
 YS = (-0.3, 0.0, 0.3)
 
 
-def sweep(robot: str, scenarios=SCENARIOS, xs=XS, ys=YS, seed: int = 0) -> dict:
-    """{scenario: {y: {"x": [...], "reward": [...], "loops": [...]}}} for one robot."""
+def sweep(robot: str, scenarios=SCENARIOS, xs=XS, ys=YS, seed: int = 0, planner_config=None) -> dict:
+    """{scenario: {y: {"x": [...], "reward": [...], "loops": [...]}}} for one robot
+    (``planner_config``: default the robot's preset)."""
     out = {}
     for scenario in scenarios:
-        env = make_env(scenario, robot=robot, seed=seed)
+        env = make_env(scenario, robot=robot, seed=seed, planner_config=planner_config)
         out[scenario] = {}
         for y in ys:
             rewards, loops = [], []

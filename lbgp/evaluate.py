@@ -32,20 +32,21 @@ def resolve_names(spec: str) -> list[str]:
 
 def evaluate(policy, method: str, names: list[str], robot: str = "jackal", episodes: int = 10, seed: int = 0,
              recorder=None, person_path=None, horizon: int = 35, obs_noise: bool | None = None, dynamics=None,
-             calibration=None, drive_model=None) -> list[dict]:
+             calibration=None, drive_model=None, planner_config=None) -> list[dict]:
     """Episode i of scenario k is seeded with (seed, k, i): every method faces the same episodes.
     ``obs_noise``: the observation noise on/off (default: on for levels, off for scenarios).
     ``dynamics``: the robot's dynamics (``lbgp.dynamics``: a name, a JSON file or a ``Dynamics``; default nominal).
     ``calibration``: the command calibration (``lbgp.calibration``; default none); ``"online"``: one
     online estimator (``lbgp.online_calibration``) for all the episodes, in order, as one robot
     doing every run keeps what it learned.
-    ``drive_model``: the planner's model of the drive (``lbgp.drive_model``; default none)."""
+    ``drive_model``: the planner's model of the drive (``lbgp.drive_model``; default none).
+    ``planner_config``: the planner's ``PlannerConfig`` (default: the robot's preset)."""
     calibration = load_calibration(calibration, robot)
     results = []
     for k, name in enumerate(names):
         env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path,
                        horizon=horizon, obs_noise=obs_noise, dynamics=dynamics, calibration=calibration,
-                       drive_model=drive_model)
+                       drive_model=drive_model, planner_config=planner_config)
         runs = []
         for i in range(episodes):
             env.reseed([seed, k, i])

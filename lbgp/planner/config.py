@@ -43,7 +43,7 @@ class PlannerConfig:
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance
     regularization: float = 1e-4  # proximal (Levenberg-Marquardt) term of each SQP step
     # sequential QP
-    sqp_iterations: int = 5  # at most, per candidate band; stops earlier at step_tolerance
+    sqp_iterations: int = 3  # at most, per candidate band; stops earlier at step_tolerance (benchmarks/sqp_iterations.py)
     sqp_time_budget: float | None = None  # s: anytime mode (deployment): no further SQP iteration once it would
     # end past this budget (at least one always runs); None: iterate to step_tolerance (simulation, reproducible)
     trust_region_v: float = 0.75  # m/s change of each segment's v per iteration

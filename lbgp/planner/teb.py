@@ -19,7 +19,8 @@ quadratic penalty) so that the QP is always feasible.
 
 Sequential QP (Gauss-Newton): each iteration rolls the commands out, linearises, and solves one QP
 for the command step with OSQP, to a stated accuracy (``osqp_eps``, then polished); iterations
-stop when no command moves more than ``step_tolerance``. The QP's sparsity is fixed: OSQP is set
+stop when no command moves more than ``step_tolerance``, or after ``sqp_iterations`` (3: short of
+convergence on most bands, a trade measured in benchmarks/sqp_iterations.py). The QP's sparsity is fixed: OSQP is set
 up once, every later solve only updates values.
 
 No hidden state: every call starts from the same deterministic first guess (a pursuit of the

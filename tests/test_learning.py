@@ -11,10 +11,11 @@ down for seed 2).
 
 Measured (`python benchmarks/learning_seeds.py --seeds 0,1,2,3`, results/learning_seeds.json;
 straight_ahead return, 35 steps, as judged here; the paper's plain actor with the goal prior,
-`D4PGConfig.paper(prior_weight=1)`; with the planner's QP refinement, 2026-12-02): trained 25.0 /
-25.7 / 25.9 / 24.4 for seeds 0-3, untrained -0.8 / 9.2 / 4.4 / 2.8, random policy 3.7 (before the
-refinement: 23.8 / 24.4 / 24.4 / 24.0, -0.8 / 9.2 / 4.3 / 2.8, 1.0): the bounds below hold for all
-four seeds. For scale, a
+`D4PGConfig.paper(prior_weight=1)`; with the planner's SQP cap of 3, 2026-12-03): trained 23.0 /
+23.6 / 25.9 / 24.1 for seeds 0-3, untrained -0.5 / 9.3 / 4.3 / 2.8, random policy 3.8 (with the cap
+of 5 and the QP refinement, 2026-12-02: 25.0 / 25.7 / 25.9 / 24.4, -0.8 / 9.2 / 4.4 / 2.8, 3.7;
+before the refinement: 23.8 / 24.4 / 24.4 / 24.0, -0.8 / 9.2 / 4.3 / 2.8, 1.0): the bounds below
+hold for all four seeds. For scale, a
 constant goal 1.5 m ahead scores ~25 (and is exactly where the default residual actor starts).
 """
 

@@ -3,8 +3,8 @@ the iteration cap (``PlannerConfig.sqp_iterations``).
 
     python benchmarks/sqp_iterations.py --json results/sqp_iterations.json --iterations 1,3,5 --jobs 2
 
-The planner stops a band's SQP at ``sqp_iterations`` (5) or when no command moves more than
-``step_tolerance``; most bands stop at the cap, short of convergence (docs/planner.md, Speed). For
+The planner stops a band's SQP at ``sqp_iterations`` (3; 5 before 2026-12-03) or when no command
+moves more than ``step_tolerance``; most bands stop at the cap, short of convergence (docs/planner.md). For
 each cap K this measures, with everything else the robot's preset:
 
 - ``speed`` (per robot, N = 20): ``bench_planner.bench``'s call median and p99, SQP iterations and
@@ -12,7 +12,8 @@ each cap K this measures, with everything else the robot's preset:
   anything else starts (timings move by 20-40 % between runs on this machine: compare within a file);
 - ``command`` (Jackal): how far the command (v, w) is from a converged band's
   (``--reference-iterations``, 30) on the same inputs: planner calls recorded along constant-goal
-  (1.5 m ahead) episodes of the 9 paper scenarios, every third call replayed;
+  (1.5 m ahead) episodes of the 9 paper scenarios driven with the cap ``--record-iterations`` (5,
+  the default when results/sqp_iterations.json was made), every third call replayed;
 - ``scores`` (Jackal): HC and the shipped LBGP on the 9 paper scenarios as ``lbgp experiment sim``
   scores them (``--episodes`` seeded episodes each, observation noise on, the sim table's seeds),
   with sums over the turning scenarios and the trajectories and LBGP minus HC;
@@ -47,12 +48,14 @@ from lbgp.sim import make_env, scenario_names  # noqa: E402
 SPEED_KEYS = ("median_ms", "p99_ms", "sqp_iterations_per_call", "qp_solves", "osqp_iterations_per_qp", "goal_env_steps_per_s")
 
 
-def recorded_calls(robot: str = "jackal", every: int = 3, scenarios=None) -> list[tuple]:
-    """The planner's inputs (args, kwargs) along constant-goal episodes, every ``every``-th call."""
+def recorded_calls(robot: str = "jackal", iterations: int = 5, every: int = 3, scenarios=None) -> list[tuple]:
+    """The planner's inputs (args, kwargs) along constant-goal episodes driven with this SQP cap,
+    every ``every``-th call."""
     calls = []
     action = action_from_goal([1.5, 0.0])
+    config = planner_config_for(robot).with_(sqp_iterations=iterations)
     for name in scenarios or scenario_names():
-        env = make_env(name, robot=robot, seed=0)
+        env = make_env(name, robot=robot, seed=0, planner_config=config)
         planner = env.task.controller.planner
         plan = planner.plan
 
@@ -74,8 +77,8 @@ def commands(calls, robot: str, iterations: int) -> tuple[np.ndarray, float]:
     return np.array([[p.v, p.w] for p in plans]), float(np.mean([p.iterations for p in plans]))
 
 
-def command_deviation(robot: str, caps: list[int], reference: int) -> dict:
-    calls = recorded_calls(robot)
+def command_deviation(robot: str, caps: list[int], reference: int, record: int = 5) -> dict:
+    calls = recorded_calls(robot, record)
     ref, ref_iterations = commands(calls, robot, reference)
     out = {"calls": len(calls), "reference_iterations": reference, "reference_sqp_iterations_per_call": ref_iterations}
     for k in caps:
@@ -109,6 +112,8 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--calls", type=int, default=500, help="planner calls timed per robot and cap")
     ap.add_argument("--episodes", type=int, default=20, help="seeded episodes per scenario and method")
     ap.add_argument("--reference-iterations", type=int, default=30)
+    ap.add_argument("--record-iterations", type=int, default=5,
+                    help="SQP cap of the planner driving the episodes whose planner inputs are replayed")
     ap.add_argument("--parts", default="speed,command,scores,goal_sweep,goal_jitter")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=1)
@@ -122,7 +127,7 @@ def main(argv: list[str] | None = None) -> dict:
         result["speed"] = {robot: {str(k): {key: bench(robot, 20, args.calls, sqp_iterations=k)[key] for key in SPEED_KEYS}
                                    for k in caps} for robot in robots}
     if "command" in parts:
-        result["command"] = command_deviation("jackal", caps, args.reference_iterations)
+        result["command"] = command_deviation("jackal", caps, args.reference_iterations, args.record_iterations)
     jobs = []
     if "scores" in parts:
         jobs += [("score", k, method, args.episodes, args.seed) for k in caps for method in ("hc", "lbgp")]

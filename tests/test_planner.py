@@ -276,11 +276,11 @@ def test_constant_goal_reward_is_smooth_in_the_goal_and_never_loops():
     assert summary["loops"] == 0
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation (docs/planner.md): a person exactly between the robot and the "
-                   "goal leaves the band no side to pass on; fixed by left/right candidate bands, not built yet")
 def test_a_robot_straight_behind_the_person_passes_to_a_goal_on_the_persons_axis():
-    """straight_behind, noise-free, the constant goal (1.5, 0): the robot should get past the person
-    and in front as it does for the goal 5 cm to either side (reward ~6 there, -18.7 here)."""
+    """straight_behind, noise-free, the constant goal (1.5, 0): the robot gets past the person and in
+    front as it does for the goal 5 cm to either side (reward ~6 there). Without the passing band it
+    stays behind (-18.7): robot, person and goal in one line leave the SQP no side to lean to."""
+    from lbgp.planner import planner_config_for
     from lbgp.rollout import ConstantGoalPolicy, run_episode
     from lbgp.sim import make_env
 
@@ -289,3 +289,28 @@ def test_a_robot_straight_behind_the_person_passes_to_a_goal_on_the_persons_axis
     on_axis = run_episode(env, ConstantGoalPolicy((1.5, 0.0))).total_reward
     assert aside > 0.0  # the side goal does get in front: the comparison below is about the axis
     assert on_axis > aside - 3.0
+    trapped_env = make_env("straight_behind", robot="jackal", seed=0,
+                           planner_config=planner_config_for("jackal").with_(pass_candidate=False))
+    assert run_episode(trapped_env, ConstantGoalPolicy((1.5, 0.0))).total_reward < aside - 10.0
+
+
+def test_a_band_stuck_behind_the_person_on_the_line_to_the_goal_gets_a_passing_candidate():
+    """Robot, person and goal in one line (a state of the straight_behind trap): the "keep" band
+    cannot lean to either side; a band that passes on the left (the tie-break) is solved beside it
+    and kept. With the person a little left of the line the band passes on the right; with the
+    person beside the robot (not between it and the goal), or a robot too slow to outrun the
+    person, no passing band is tried."""
+    planner = TebPlanner(JACKAL_PLANNER)
+    state = dict(robot_pose=[-1.3, 0.0, 0.0], robot_velocity=[0.75, 0.0], person_velocity=[0.6, 0.0],
+                 goal_moves_with_person=True)
+    plan = planner.plan(goal=[1.8, 0.0], person_pose=[0.3, 0.0, 0.0], **state)
+    assert plan.ok and plan.candidate == "left" and "left" in plan.tried and "right" not in plan.tried
+    assert plan.w > 0.0 and plan.poses[-1, 1] > 0.1  # on its way round the person's left
+    mirrored = planner.plan(goal=[1.8, 0.05], person_pose=[0.3, 0.05, 0.0], **state)
+    assert mirrored.ok and "right" in mirrored.tried and mirrored.poses[-1, 1] < 0.0
+    beside = planner.plan(goal=[1.8, 1.5], person_pose=[0.3, 1.5, 0.0], **state)
+    assert beside.ok and not {"left", "right"} & set(beside.tried)
+    slow = TebPlanner(TURTLEBOT2_PLANNER).plan(goal=[1.8, 0.0], person_pose=[0.3, 0.0, 0.0], **state)
+    assert slow.ok and slow.tried[0] == "keep" and not {"left", "right"} & set(slow.tried)
+    off = TebPlanner(JACKAL_PLANNER.with_(pass_candidate=False)).plan(goal=[1.8, 0.0], person_pose=[0.3, 0.0, 0.0], **state)
+    assert off.ok and not {"left", "right"} & set(off.tried) and abs(off.poses[-1, 1]) < 1e-6  # the trap: straight on, behind

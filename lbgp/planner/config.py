@@ -55,6 +55,7 @@ class PlannerConfig:
     weight_time_to_go: float = 2.0  # per s: candidate bands are compared with the time they leave to the goal
     wait_candidate: bool = True  # also solve a band that brakes first when the band passes near the person
     wait_margin: float = 0.3  # m beyond the safety distance that counts as near
+    pass_candidate: bool = True  # also solve a band that passes the person on one side when the band is stuck behind them
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)
     osqp_max_iter: int = 4000
     osqp_eps: float = 1e-3  # absolute and relative tolerance of every QP, then polished (exact active set)

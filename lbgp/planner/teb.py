@@ -31,7 +31,9 @@ velocity, person pose and velocity, goal) alone, exactly: where two candidate ba
 Local minima (TEB's remedy: bands in distinct topologies): for a goal that will still be behind
 the robot at the end of the horizon, a forwards-only band that turns the robot around is solved
 beside the one that may back up; when the band passes near the person's predicted path, one that
-starts by braking (let the person cross first). The cheapest band is kept, its cost including the
+starts by braking (let the person cross first); when the band is stuck behind the person on the
+line to the goal (robot, person and goal in one line leave the SQP no side to lean to), one that
+passes the person on one side. The cheapest band is kept, its cost including the
 time it leaves to the goal (at the speed its last pose allows towards the goal).
 
 A goal within the person's safety distance, bad input, a failed QP, or a next pose that would go
@@ -73,7 +75,8 @@ class Plan:
     person_prediction: np.ndarray  # (N, 2) predicted person positions at those times
     iterations: int = 0  # SQP iterations, all candidate bands together
     solve_time: float = 0.0  # s, wall time of this call
-    candidate: str = ""  # which first guess the kept band came from ("keep" or "turn")
+    candidate: str = ""  # which first guess the kept band came from ("keep", "turn", "wait", "left" or "right")
+    tried: tuple[str, ...] = ()  # the candidate bands solved, in order
 
     @property
     def ok(self) -> bool:
@@ -190,15 +193,19 @@ class TebPlanner:
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_off_heading(problem):
             candidates.append("turn")
-        best, iterations = None, 0
+        best, iterations, tried = None, 0, []
         while candidates:
             name = candidates.pop(0)
+            if name in tried:
+                continue  # a band's outcome depends on its problem and name only: solving it twice changes nothing
+            tried.append(name)
             if name != "keep" and self._over_budget(t_start, iterations):
                 break
             # every band from a fresh start: no state from earlier calls or from the band before (the same
             # input gives the same QPs, solved the same way; a warm start from another band can stall OSQP)
             self._qp.restart()
-            v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, problem.goal_path, goal_vel, self.h,
+            guide = self._passing_guide(problem, name) if name in ("left", "right") else problem.goal_path
+            v0, w0 = pursuit_commands(robot_pose, problem.v_ref, problem.w_ref, guide, goal_vel, self.h,
                                       cfg.control_period, self.M, cfg, reverse=(name != "turn"), wait=(name == "wait"))
             lower = self._forward_only(problem) if name == "turn" else self._u_lo  # turning around: forwards only
             band_problem = self._facing_goal(problem) if name == "turn" else problem
@@ -215,12 +222,14 @@ class TebPlanner:
                 best = (cost, u, name, poses, clearance)
             if name != "wait" and cfg.wait_candidate and clearance.min() < cfg.safety_distance + cfg.wait_margin:
                 candidates.append("wait")  # the band passes near the person's path: also try letting them pass
+            if name == "keep" and cfg.pass_candidate and (side := self._blocked_side(problem, poses)):
+                candidates.append(side)  # the band is stuck behind the person: also try passing them on one side
         _, u, name, poses, clearance = best
         now = float(np.hypot(*(robot_pose[:2] - person_pose[:2])))
         if clearance[0] < cfg.safety_distance - cfg.clearance_tolerance and clearance[0] < now:
             return self._stop(v_now, w_now, INFEASIBLE, t_start, poses, problem, iterations)
         v, w = clamp_command(float(u[0]), float(u[self.M]), v_now, w_now, cfg)
-        return self._result(v, w, OK, poses, problem, iterations, t_start, name)
+        return self._result(v, w, OK, poses, problem, iterations, t_start, name, tuple(tried))
 
     # ------------------------------------------------------------------ helpers
     def _goal_off_heading(self, problem: _Problem) -> bool:
@@ -235,6 +244,46 @@ class TebPlanner:
         dist = math.hypot(dx, dy)
         ahead = math.cos(th) * dx + math.sin(th) * dy
         return dist > self.cfg.turn_candidate_distance and ahead < math.cos(self.cfg.turn_candidate_angle) * dist
+
+    def _blocked_side(self, problem: _Problem, poses: np.ndarray) -> str:
+        """The side to pass the person on when the band is stuck behind them, else "".
+
+        Stuck: the person stands within the safety distance of the straight line from the robot to
+        where the goal will be (between the two), and the band ends behind the person (on the far
+        side from the goal) within the safety distance of the person's line to the goal. With the
+        robot, the person and the goal in one line, every linearised clearance half-plane faces
+        straight back and no SQP step leans to either side (docs/planner.md, "A person straight
+        between the robot and the goal"). The side is the one the robot already leans to, left
+        when it is exactly on the line (a deterministic tie-break). Only a robot that can outrun
+        the person by the safety distance over the band's horizon tries (a TurtleBot 2 behind a
+        person walking at 0.6 m/s cannot pass them, so it does not pay for the band)."""
+        cfg, safety = self.cfg, self.cfg.safety_distance
+        robot, person, goal = problem.pose0[:2], problem.person_path[0], problem.goal_path[-1]
+        person_speed = float(np.hypot(*(problem.person_path[1] - person))) / self.h
+        if (cfg.max_vel_x - person_speed) * self._times[-1] < safety:
+            return ""
+        d, r = goal - robot, person - robot
+        length = float(np.hypot(*d))
+        if length < 1e-9 or not 0.0 < float(r @ d) < length**2:
+            return ""
+        lean = float(d[0] * r[1] - d[1] * r[0]) / length  # > 0: the person is left of the robot's line to the goal
+        if abs(lean) >= safety:
+            return ""
+        person_end = problem.person_path[-1]
+        ahead, end = goal - person_end, poses[-1, :2] - person_end
+        length = float(np.hypot(*ahead))
+        if length < 1e-9 or float(end @ ahead) >= 0.0 or abs(float(ahead[0] * end[1] - ahead[1] * end[0])) >= safety * length:
+            return ""
+        return "right" if lean > 0.0 else "left"
+
+    def _passing_guide(self, problem: _Problem, side: str) -> np.ndarray:
+        """The first guess of a band that passes the person on ``side``: a pursuit of the goal's
+        path shifted sideways (perpendicular to the robot's line to the person) by the safety
+        distance plus ``wait_margin``; the SQP then pulls the band back onto the goal."""
+        d = problem.person_path[0] - problem.pose0[:2]
+        normal = np.array([-d[1], d[0]]) / max(float(np.hypot(*d)), 1e-9)
+        shift = (self.cfg.safety_distance + self.cfg.wait_margin) * (1.0 if side == "left" else -1.0)
+        return problem.goal_path + shift * normal[None, :]
 
     @staticmethod
     def _facing_goal(problem: _Problem) -> _Problem:
@@ -268,10 +317,11 @@ class TebPlanner:
         spent = time.perf_counter() - t_start
         return spent + spent / iterations > budget
 
-    def _result(self, v, w, status, poses, problem, iterations, t_start, candidate="") -> Plan:
+    def _result(self, v, w, status, poses, problem, iterations, t_start, candidate="", tried=()) -> Plan:
         poses = poses.copy()
         poses[:, 2] = wrap_angle(poses[:, 2])
-        return Plan(v, w, status, poses, self._times.copy(), problem.person_path.copy(), iterations, time.perf_counter() - t_start, candidate)
+        return Plan(v, w, status, poses, self._times.copy(), problem.person_path.copy(), iterations, time.perf_counter() - t_start,
+                    candidate, tried)
 
     def _stop(self, v_now, w_now, status, t_start, poses=None, problem=None, iterations=0) -> Plan:
         v, w = safe_stop(v_now, w_now, self.cfg)

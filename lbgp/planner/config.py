@@ -59,7 +59,8 @@ class PlannerConfig:
     control_period: float = 0.1  # s between planner calls (for the acceleration clamp)
     osqp_max_iter: int = 4000
     osqp_eps: float = 1e-3  # absolute and relative tolerance of every QP, then polished (exact active set)
-    osqp_rho: float = 0.1  # OSQP's initial ADMM step size (its default), where every call's first QP starts
+    osqp_rho: float = 0.03  # OSQP's initial ADMM step size, where every band's first QP starts (OSQP's default 0.1
+    # needs ~15-25 % more ADMM iterations per QP here: docs/planner.md, "The initial step size")
     # a QP whose active set polishing did not confirm is continued to this tolerance and polished again
     # (None: accurate to osqp_eps only); that pass stops at osqp_refine_max_iter, keeping whichever
     # iterate has the smaller residuals (docs/planner.md: the 1 cm accuracy target needs it)

@@ -40,7 +40,7 @@ from lbgp.sim import make_env, scenario_names  # noqa: E402
 def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) -> dict:
     """``overrides``: PlannerConfig fields to change (e.g. osqp_eps, osqp_rho)."""
     cfg = planner_config_for(robot).with_(n_poses=n_poses, **overrides)
-    times, statuses, iterations, candidates, recorded = [], [], [], [], []
+    times, solver_times, statuses, iterations, candidates, recorded = [], [], [], [], [], []
     action = action_from_goal([1.5, 0.0])
     steps, t_env = 0, 0.0
     scenarios = scenario_names()
@@ -52,9 +52,11 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
         original_plan, original_step = planner.plan, planner._sqp_step
 
         def timed(*a, **kw):
+            solver_before = planner._qp.stats.solver_seconds
             t0 = time.perf_counter()
             plan = original_plan(*a, **kw)
             times.append(time.perf_counter() - t0)
+            solver_times.append(planner._qp.stats.solver_seconds - solver_before)
             statuses.append(plan.status)
             iterations.append(plan.iterations)
             candidates.append(plan.candidate)
@@ -82,11 +84,17 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
             totals[k] += planner.stats[k]
         i += 1
     ms = np.array(times[:calls]) * 1000.0
+    solver_ms = np.array(solver_times[:calls]) * 1000.0
     result = {
         "calls": int(len(ms)),
         "median_ms": float(np.median(ms)),
         "p99_ms": float(np.percentile(ms, 99)),
         "max_ms": float(ms.max()),
+        # the part of each call spent inside OSQP's compiled calls (updates, solves, rescues, refinement),
+        # and the rest (Python: rollouts, linearisation, bounds, first guesses, scoring)
+        "osqp_ms": {"median": float(np.median(solver_ms)), "p99": float(np.percentile(solver_ms, 99)),
+                    "share_of_call_time": float(solver_ms.sum() / ms.sum())},
+        "outside_osqp_ms": {"median": float(np.median(ms - solver_ms)), "p99": float(np.percentile(ms - solver_ms, 99))},
         "status_counts": {s: statuses.count(s) for s in sorted(set(statuses))},
         "candidate_counts": {c or "none": candidates.count(c) for c in sorted(set(candidates))},
         "sqp_iterations_per_call": float(np.mean(iterations)),

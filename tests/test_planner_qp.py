@@ -43,6 +43,25 @@ def test_sequence_of_solves_matches_the_public_interface():
     assert qp.stats.solves == 6 and qp.stats.osqp_iterations > 0 and qp.stats.max_iter_hits == 0
 
 
+def test_time_inside_osqp_is_counted_and_is_part_of_the_solve_time():
+    """``stats.solver_seconds`` adds up the time inside OSQP's compiled calls: it grows with every
+    solve and never exceeds the wall time of the solves around it."""
+    import time
+
+    rng = np.random.default_rng(1)
+    n, m = 12, 18
+    P, pattern = random_problem(rng, n, m)
+    qp = SparseQP(n, m, P.data, (P.indices, P.indptr), (pattern.indices, pattern.indptr), eps=1e-8, max_iter=20000)
+    counted = []
+    t0 = time.perf_counter()
+    for _ in range(3):
+        A, q, lower, upper = values(rng, pattern, n, m)
+        assert qp.solve(A.data, q, lower, upper) == SOLVED
+        counted.append(qp.stats.solver_seconds)
+    elapsed = time.perf_counter() - t0
+    assert 0.0 < counted[0] < counted[1] < counted[2] <= elapsed
+
+
 def test_infeasible_and_capped_problems_say_so():
     rng = np.random.default_rng(1)
     n, m = 12, 18

@@ -11,6 +11,7 @@ up through the public interface and then talks to the compiled solver object dir
 from __future__ import annotations
 
 import dataclasses
+import time
 
 import numpy as np
 import osqp
@@ -40,6 +41,7 @@ class QPStats:
     refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
     refine_capped: int = 0  # ... whose refinement stopped at its cap with smaller residuals than the first pass (kept)
     refine_fallbacks: int = 0  # ... whose refinement failed or stopped at its cap no better (the first pass's solution kept)
+    solver_seconds: float = 0.0  # wall time inside OSQP's compiled calls (set-up, update, solve, rescue, refinement)
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -88,6 +90,7 @@ class SparseQP:
         ``primal_infeasible`` or ``failed``."""
         lower = np.maximum(lower, -self._infinity)
         upper = np.minimum(upper, self._infinity)
+        t_start = time.perf_counter()
         if self._solver is None:
             wrapper = osqp.OSQP()
             wrapper.setup(self._P, q, sp.csc_matrix((A_values, *self._A_pattern), shape=(self.m, self.n)), lower, upper,
@@ -99,6 +102,7 @@ class SparseQP:
             self._solver.update_data_mat(P_x=None, P_i=None, A_x=A_values, A_i=None)
         self._solver.solve()
         stats = self.stats
+        stats.solver_seconds += time.perf_counter() - t_start
         stats.solves += 1
         stats.osqp_iterations += int(self._solver.info.iter)
         wrapper = self._wrapper
@@ -115,10 +119,12 @@ class SparseQP:
         The same QP is solved once more by a fresh solver that adapts its step size twice as often
         (``RESCUE_RHO_INTERVAL``); returns that solver, whose outcome counts instead."""
         self.stats.rescues += 1
+        t_start = time.perf_counter()
         rescue = osqp.OSQP()
         rescue.setup(self._P, q, sp.csc_matrix((A_values, *self._A_pattern), shape=(self.m, self.n)), lower, upper,
                      **dict(self._settings, adaptive_rho_interval=RESCUE_RHO_INTERVAL))
         rescue._solver.solve()
+        self.stats.solver_seconds += time.perf_counter() - t_start
         self.stats.osqp_iterations += int(rescue._solver.info.iter)
         if rescue._solver.info.status_val not in _SOLVED:
             self.stats.rescue_failures += 1
@@ -152,7 +158,9 @@ class SparseQP:
         first_residual = max(solver.info.prim_res, solver.info.dual_res)
         wrapper.update_settings(eps_abs=self._refine_eps, eps_rel=self._refine_eps, max_iter=self._refine_max_iter)
         try:
+            t_start = time.perf_counter()
             solver.solve()  # from the first pass's iterate
+            stats.solver_seconds += time.perf_counter() - t_start
             info = solver.info
             stats.osqp_iterations += int(info.iter)
             if info.status_val in _SOLVED:

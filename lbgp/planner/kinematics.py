@@ -45,29 +45,33 @@ def pursuit_commands(pose0, v_start: float, w_start: float, goal_path, goal_vel,
     x, y, th = float(pose0[0]), float(pose0[1]), float(pose0[2])
     gvx, gvy = float(goal_vel[0]), float(goal_vel[1])
     v_prev, w_prev = v_start, w_start
-    vs, ws = np.empty(M), np.empty(M)
+    vs, ws = [0.0] * M, [0.0] * M
     tau_v, tau_w, look = 0.6, 0.35, 1.0  # s: time constants and look-ahead (only shape the first guess)
-    for k in range(M):
-        rx, ry = float(goal_path[k, 0]) - x, float(goal_path[k, 1]) - y
-        c, s = math.cos(th), math.sin(th)
+    acc_v, acc_w = limits.acc_lim_x, limits.acc_lim_theta
+    v_lo, v_hi, w_hi = -limits.max_vel_x_backwards, limits.max_vel_x, limits.max_vel_theta
+    sin, cos, atan2 = math.sin, math.cos, math.atan2
+    half_pi, pi = 0.5 * math.pi, math.pi
+    for k, (gx, gy) in enumerate(goal_path[:M].tolist()):
+        rx, ry = gx - x, gy - y
+        c, s = cos(th), sin(th)
         # steer towards where the goal will be ``look`` s later: well defined even on the goal
         ax, ay = rx + gvx * look, ry + gvy * look
-        e = math.atan2(ay, ax) - th
-        e = math.atan2(math.sin(e), math.cos(e))
-        if reverse and abs(e) > 0.5 * math.pi:
-            e = e - math.copysign(math.pi, e)
+        e = atan2(ay, ax) - th
+        e = atan2(sin(e), cos(e))
+        if reverse and abs(e) > half_pi:
+            e = e - math.copysign(pi, e)
         v_des = 0.0 if wait else (gvx * c + gvy * s) + (rx * c + ry * s) / tau_v
         if not reverse:
             v_des = max(v_des, 0.0)  # turning the front towards the goal: turn (on the spot), never back up
         w_des = e / tau_w * min(1.0, math.hypot(ax, ay) / 0.3)
         dt_acc = first_period if k == 0 else h
-        dv, dw = limits.acc_lim_x * dt_acc, limits.acc_lim_theta * dt_acc
-        v = min(max(v_des, v_prev - dv, -limits.max_vel_x_backwards), v_prev + dv, limits.max_vel_x)
-        w = min(max(w_des, w_prev - dw, -limits.max_vel_theta), w_prev + dw, limits.max_vel_theta)
+        dv, dw = acc_v * dt_acc, acc_w * dt_acc
+        v = min(max(v_des, v_prev - dv, v_lo), v_prev + dv, v_hi)
+        w = min(max(w_des, w_prev - dw, -w_hi), w_prev + dw, w_hi)
         phi = th + 0.5 * w * h
-        x += v * h * math.cos(phi)
-        y += v * h * math.sin(phi)
+        x += v * h * cos(phi)
+        y += v * h * sin(phi)
         th += w * h
         vs[k], ws[k] = v, w
         v_prev, w_prev = v, w
-    return vs, ws
+    return np.array(vs), np.array(ws)

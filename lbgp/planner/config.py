@@ -65,7 +65,7 @@ class PlannerConfig:
     # (None: accurate to osqp_eps only); that pass stops at osqp_refine_max_iter, keeping whichever
     # iterate has the smaller residuals (docs/planner.md: the 1 cm accuracy target needs it)
     osqp_refine_eps: float | None = 1e-4
-    osqp_refine_max_iter: int = 300
+    osqp_refine_max_iter: int = 1000  # 300 until 2026-12-03: one TurtleBot 2 QP stopped there 1.5 cm off (docs/planner.md)
 
     @property
     def safety_distance(self) -> float:

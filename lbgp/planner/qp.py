@@ -39,7 +39,8 @@ class QPStats:
     rescues: int = 0  # solves that hit the cap, solved again by a fresh solver (``SparseQP._rescue``)
     rescue_failures: int = 0  # ... which did not solve it either (the solve failed)
     refined: int = 0  # solves that polishing did not confirm, continued to ``refine_eps``
-    refine_capped: int = 0  # ... whose refinement stopped at its cap with smaller residuals than the first pass (kept)
+    refine_capped: int = 0  # ... whose refinement stopped at its cap (OSQP: "solved inaccurate", or not solved but
+    # with smaller residuals than the first pass); the iterate is kept
     refine_fallbacks: int = 0  # ... whose refinement failed or stopped at its cap no better (the first pass's solution kept)
     solver_seconds: float = 0.0  # wall time inside OSQP's compiled calls (set-up, update, solve, rescue, refinement)
 
@@ -168,6 +169,8 @@ class SparseQP:
                 if np.all(np.isfinite(x)):
                     self.x = x
                 stats.unpolished += info.status_polish != 1
+                # at its iteration cap OSQP reports "solved inaccurate" where the residuals are within 10x eps
+                stats.refine_capped += info.status_val == osqp.SolverStatus.OSQP_SOLVED_INACCURATE
             elif (info.status_val == osqp.SolverStatus.OSQP_MAX_ITER_REACHED
                   and max(info.prim_res, info.dual_res) < first_residual
                   and np.all(np.isfinite(x := np.array(solver.solution.x, dtype=float)))):

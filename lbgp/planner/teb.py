@@ -451,33 +451,43 @@ class TebPlanner:
         """SQP from the commands ``u``; returns (u, status, iterations). Converged when no command
         moves more than ``step_tolerance`` in an iteration."""
         cfg = self.cfg
-        lo, hi = self._bounds(problem, u, lower)
-        u = np.clip(u, lo, hi)
+        floor = abs(problem.w_ref) - self._braking_w  # the turn-rate cap never below this (see _bounds)
+        u, lo, hi = self._clipped(u, lower, floor)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
                 done -= 1
                 break
-            step, status = self._sqp_step(problem, u, *self._bounds(problem, u, lower))
+            step, status = self._sqp_step(problem, u, lo, hi)
             if status != OK:
                 return u, status, done
-            u = np.clip(u + step, *self._bounds(problem, u + step, lower))
+            u, lo, hi = self._clipped(u + step, lower, floor)
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
             if float(np.max(np.abs(step))) < cfg.step_tolerance:
                 break
         return u, OK, done
 
-    def _bounds(self, problem: _Problem, u: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _clipped(self, u: np.ndarray, lower: np.ndarray, floor: np.ndarray):
+        """``u`` clipped to its command bounds, and the bounds at the clipped commands (the same
+        bounds unless clipping changed a v: the turn-rate cap depends on v only)."""
+        M = self.M
+        lo, hi = self._bounds(u, lower, floor)
+        clipped = np.clip(u, lo, hi)
+        if not np.array_equal(clipped[:M], u[:M]):
+            lo, hi = self._bounds(clipped, lower, floor)
+        return clipped, lo, hi
+
+    def _bounds(self, u: np.ndarray, lower: np.ndarray, floor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Command bounds: the velocity limits, and |w| <= lateral_acc_limit / |v| (evaluated at the
-        current v; a fast robot turns gently), never tighter than what the angular acceleration
-        limit lets the robot reach from its current turn rate."""
+        current v; a fast robot turns gently), never tighter than ``floor``, what the angular
+        acceleration limit lets the robot reach from its current turn rate."""
         cfg, M = self.cfg, self.M
         cap = np.minimum(cfg.max_vel_theta, cfg.lateral_acc_limit / np.maximum(np.abs(u[:M]), 1e-6))
-        cap = np.maximum(cap, abs(problem.w_ref) - self._braking_w)
+        np.maximum(cap, floor, out=cap)
         lo, hi = lower.copy(), self._u_hi.copy()
-        lo[M:] = np.maximum(lo[M:], -cap)
-        hi[M:] = np.minimum(hi[M:], cap)
+        np.maximum(lo[M:], -cap, out=lo[M:])
+        np.minimum(hi[M:], cap, out=hi[M:])
         return lo, hi
 
     def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, upper: np.ndarray):

@@ -60,6 +60,11 @@ def test_time_inside_osqp_is_counted_and_is_part_of_the_solve_time():
         counted.append(qp.stats.solver_seconds)
     elapsed = time.perf_counter() - t0
     assert 0.0 < counted[0] < counted[1] < counted[2] <= elapsed
+    # its parts: the value updates (every solve after the set-up), polishing (on for every solve), refinement
+    stats = qp.stats
+    assert stats.update_seconds > 0.0 and stats.polish_seconds > 0.0 and stats.refine_seconds >= 0.0
+    assert stats.update_seconds + stats.polish_seconds + stats.refine_seconds <= stats.solver_seconds
+    assert 0 <= stats.refine_iterations <= stats.osqp_iterations
 
 
 def test_infeasible_and_capped_problems_say_so():

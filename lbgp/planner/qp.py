@@ -43,6 +43,12 @@ class QPStats:
     # with smaller residuals than the first pass); the iterate is kept
     refine_fallbacks: int = 0  # ... whose refinement failed or stopped at its cap no better (the first pass's solution kept)
     solver_seconds: float = 0.0  # wall time inside OSQP's compiled calls (set-up, update, solve, rescue, refinement)
+    # ... of which: the value updates (update_data_mat refactorises the KKT matrix), polishing (OSQP's own clock),
+    # and the refinement passes (their ADMM iterations are also counted apart)
+    update_seconds: float = 0.0
+    polish_seconds: float = 0.0
+    refine_seconds: float = 0.0
+    refine_iterations: int = 0
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -101,13 +107,16 @@ class SparseQP:
         else:
             self._solver.update_data_vec(q=q, l=lower, u=upper)
             self._solver.update_data_mat(P_x=None, P_i=None, A_x=A_values, A_i=None)
+            self.stats.update_seconds += time.perf_counter() - t_start
         self._solver.solve()
         stats = self.stats
         stats.solver_seconds += time.perf_counter() - t_start
         stats.solves += 1
-        stats.osqp_iterations += int(self._solver.info.iter)
+        info = self._solver.info
+        stats.osqp_iterations += int(info.iter)
+        stats.polish_seconds += float(info.polish_time)
         wrapper = self._wrapper
-        if self._solver.info.status_val == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
+        if info.status_val == osqp.SolverStatus.OSQP_MAX_ITER_REACHED:
             stats.max_iter_hits += 1
             wrapper = self._rescue(A_values, q, lower, upper)
         status = self._accept(wrapper)
@@ -161,9 +170,13 @@ class SparseQP:
         try:
             t_start = time.perf_counter()
             solver.solve()  # from the first pass's iterate
-            stats.solver_seconds += time.perf_counter() - t_start
+            elapsed = time.perf_counter() - t_start
+            stats.solver_seconds += elapsed
+            stats.refine_seconds += elapsed
             info = solver.info
             stats.osqp_iterations += int(info.iter)
+            stats.refine_iterations += int(info.iter)
+            stats.polish_seconds += float(info.polish_time)
             if info.status_val in _SOLVED:
                 x = np.array(solver.solution.x, dtype=float)
                 if np.all(np.isfinite(x)):

@@ -37,17 +37,29 @@ from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.sim import make_env, scenario_names  # noqa: E402
 
 
+GOAL = (1.5, 0.0)  # the scripted goal in the person's frame (m), every episode
+
+
+def bench_envs(robot: str, planner_config=None):
+    """The benchmark's goal-driven episodes in order, endlessly: the paper's scenarios in turn,
+    seeded 0, 1, 2, ... (drive each with ``action_from_goal(GOAL)``)."""
+    scenarios = scenario_names()
+    i = 0
+    while True:
+        yield make_env(scenarios[i % len(scenarios)], robot=robot, seed=i, planner_config=planner_config)
+        i += 1
+
+
 def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) -> dict:
     """``overrides``: PlannerConfig fields to change (e.g. osqp_eps, osqp_rho)."""
     cfg = planner_config_for(robot).with_(n_poses=n_poses, **overrides)
     times, solver_times, statuses, iterations, candidates, recorded = [], [], [], [], [], []
-    action = action_from_goal([1.5, 0.0])
+    action = action_from_goal(GOAL)
     steps, t_env = 0, 0.0
-    scenarios = scenario_names()
+    envs = bench_envs(robot, cfg)
     totals = {"solves": 0, "osqp_iterations": 0, "max_iter_hits": 0, "rescues": 0, "rescue_failures": 0, "unpolished": 0, "refined": 0, "refine_capped": 0, "refine_fallbacks": 0}
-    i = 0
     while len(times) < calls:
-        env = make_env(scenarios[i % len(scenarios)], robot=robot, seed=i, planner_config=cfg)
+        env = next(envs)
         planner = env.task.controller.planner
         original_plan, original_step = planner.plan, planner._sqp_step
 
@@ -82,7 +94,6 @@ def bench(robot: str, n_poses: int, calls: int, accuracy: int = 0, **overrides) 
         t_env += time.perf_counter() - t0
         for k in totals:
             totals[k] += planner.stats[k]
-        i += 1
     ms = np.array(times[:calls]) * 1000.0
     solver_ms = np.array(solver_times[:calls]) * 1000.0
     result = {

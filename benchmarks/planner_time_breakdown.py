@@ -25,20 +25,20 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
+from bench_planner import GOAL, bench_envs  # noqa: E402
 
 from lbgp.actions import action_from_goal  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.planner.teb import TebPlanner  # noqa: E402
-from lbgp.sim import make_env, scenario_names  # noqa: E402
 
 
 def record_calls(robot: str, calls: int) -> list:
     """The (args, kwargs) of ``calls`` planner calls along bench_planner's goal-driven episodes."""
-    recorded, i = [], 0
-    action = action_from_goal([1.5, 0.0])
-    scenarios = scenario_names()
+    recorded = []
+    action = action_from_goal(GOAL)
+    envs = bench_envs(robot, planner_config_for(robot))
     while len(recorded) < calls:
-        env = make_env(scenarios[i % len(scenarios)], robot=robot, seed=i)
+        env = next(envs)
         planner = env.task.controller.planner
         original = planner.plan
 
@@ -50,7 +50,6 @@ def record_calls(robot: str, calls: int) -> list:
         ts = env.reset()
         while not ts.last() and len(recorded) < calls:
             ts = env.step(action)
-        i += 1
     return recorded[:calls]
 
 

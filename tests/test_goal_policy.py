@@ -246,3 +246,44 @@ def test_turn_lead_needs_a_residual_actor():
     with pytest.raises(ValueError, match="turn_lead"):
         Actor(obs_lib.SIZE, 2, (8,), turn_lead=0.4)
     assert make_actor(D4PGConfig(method="e2e", turn_lead=0.4), obs_lib.SIZE, 2).turn_lead == 0.0
+
+
+@pytest.mark.parametrize("turn_rate", [-0.4, 0.0, 0.3])
+def test_motion_features_read_the_persons_and_the_robots_motion_off_the_observation(turn_rate):
+    """The person walks at 0.8 m/s on an arc with the robot held 1.5 m ahead: the features give the
+    person's speed ahead, their turn rate, and the robot's ground velocity in the person frame (the
+    person's plus the swing of the 1.5 m lever, 1.5 * turn rate to the left), all exact on a
+    straight walk; the mirror image negates the lateral velocities and the turn rate. On an arc the
+    estimates lag the turn: the displacements they difference were walked up to two frames ago, on
+    headings up to 2 * turn rate * FRAME_PERIOD behind (hence the tolerance)."""
+    obs = _turning_observation(turn_rate, speed=0.8)
+    person_vx, person_vy, turn, robot_vx, robot_vy = obs @ obs_lib.motion_feature_weights()
+    tol = 1e-5 if turn_rate == 0 else 0.8 * abs(turn_rate) * 2 * obs_lib.FRAME_PERIOD
+    assert person_vx == pytest.approx(0.8, abs=tol) and person_vy == pytest.approx(0.0, abs=tol)
+    assert turn == pytest.approx(turn_rate, abs=1e-5)
+    assert robot_vx == pytest.approx(0.8, abs=tol) and robot_vy == pytest.approx(1.5 * turn_rate, abs=tol)
+    mirrored = obs_lib.mirror(obs) @ obs_lib.motion_feature_weights()
+    assert np.allclose(mirrored, [person_vx, -person_vy, -turn, robot_vx, -robot_vy], atol=1e-6)
+
+
+def test_motion_feature_networks_standardise_the_features_and_round_trip_through_a_policy_file(tmp_path):
+    cfg = D4PGConfig(hidden=(8,), motion_features=True)
+    learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
+    obs = np.stack([_turning_observation(w, speed=s) for w in (-0.4, 0.0, 0.3) for s in (0.4, 0.8)]).astype(np.float32)
+    learner.set_obs_stats(obs)
+    inputs = np.concatenate([obs, obs @ obs_lib.motion_feature_weights()], axis=1)
+    for net in (learner.actor, learner.target_actor, learner.critic, learner.target_critic):
+        assert net.norm.obs_mean.shape == (obs_lib.SIZE + len(obs_lib.MOTION_FEATURES),)
+        assert torch.allclose(net.norm.obs_mean, torch.from_numpy(inputs.mean(0)), atol=1e-5)
+    assert learner.critic(torch.from_numpy(obs), torch.zeros(len(obs), 2)).shape == (len(obs), cfg.num_atoms)
+    actor = learner.actor
+    with torch.no_grad():
+        actor.net[-1].weight.normal_(0.0, 0.3)
+    save_policy(tmp_path / "m.pt", actor, "lbgp", "jackal", (8,), residual_scale=actor.residual_scale)
+    policy = load_policy(tmp_path / "m.pt", goal_deadband=0.0, mirror_average=False)
+    assert policy.actor.inputs.motion_features
+    expected = actor(torch.from_numpy(obs)).detach().numpy()
+    assert np.allclose([policy.act(o) for o in obs], expected, atol=1e-6)
+    with pytest.raises(ValueError, match="motion_features"):
+        Actor(obs_lib.SIZE - 3, 2, (8,), motion_features=True)
+    assert not make_actor(D4PGConfig(hidden=(8,)), obs_lib.SIZE, 2).inputs.motion_features

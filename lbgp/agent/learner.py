@@ -17,14 +17,15 @@ def make_actor(cfg: D4PGConfig, obs_size: int, action_size: int) -> Actor:
     """The actor a config asks for (the learner's and every actor process's)."""
     base = action_from_goal(DESIRED_GOAL) if cfg.actor_residual_scale > 0 else None
     return Actor(obs_size, action_size, cfg.hidden, residual_scale=cfg.actor_residual_scale, base=base,
-                 turn_lead=cfg.turn_lead if cfg.actor_residual_scale > 0 else 0.0)
+                 turn_lead=cfg.turn_lead if cfg.actor_residual_scale > 0 else 0.0, motion_features=cfg.motion_features)
 
 
 class D4PGLearner:
     def __init__(self, cfg: D4PGConfig, obs_size: int, action_size: int):
         self.cfg = cfg
         self.actor = make_actor(cfg, obs_size, action_size)
-        self.critic = DistributionalCritic(obs_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden)
+        self.critic = DistributionalCritic(obs_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden,
+                                           motion_features=cfg.motion_features)
         self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
         self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
@@ -38,9 +39,11 @@ class D4PGLearner:
 
     def set_obs_stats(self, observations) -> None:
         """Fix the input standardisation of all four networks from a sample of observations
-        (called once, on the first replay contents, before the first update)."""
-        obs = torch.as_tensor(observations, dtype=torch.float32)
-        mean, std = obs.mean(0), obs.std(0)
+        (called once, on the first replay contents, before the first update); with motion features
+        the statistics are those of the networks' inputs, the features included."""
+        with torch.no_grad():
+            inputs = self.actor.inputs(torch.as_tensor(observations, dtype=torch.float32))
+        mean, std = inputs.mean(0), inputs.std(0)
         for net in (self.actor, self.target_actor, self.critic, self.target_critic):
             net.set_obs_stats(mean, std)
         self.obs_stats_set = True

@@ -16,6 +16,11 @@ The actor has two output forms:
   per rad/s of the person's turn rate as the observation shows it
   (``lbgp.sim.observation.turn_rate_weights``), because a robot tracking a goal around a turning
   person falls behind it (docs/training.md).
+
+With ``motion_features`` both networks also see five motion estimates read linearly off the
+observation (the person's velocity and turn rate, the robot's velocity; ``motion_feature_weights``),
+appended to it before the standardisation: nothing the stacked frames do not hold, only
+differences the network need not learn.
 """
 
 from __future__ import annotations
@@ -25,7 +30,8 @@ import torch
 from torch import nn
 
 from lbgp.actions import GOAL_X
-from lbgp.sim.observation import turn_rate_weights
+from lbgp.sim.observation import SIZE as OBS_SIZE
+from lbgp.sim.observation import motion_feature_weights, turn_rate_weights
 
 MIN_OBS_STD = 0.01  # floor of the standardisation's std (scaled units: 6 cm, 1.8 deg): pure-noise
 # dimensions are not blown up
@@ -57,14 +63,34 @@ class Standardizer(nn.Module):
         return (obs - self.obs_mean) / self.obs_std
 
 
+class NetworkInputs(nn.Module):
+    """The observation, with the motion estimates appended when asked (``motion_features``), as
+    both networks see it before standardising it (``size`` numbers)."""
+
+    def __init__(self, obs_size: int, motion_features: bool = False):
+        super().__init__()
+        self.motion_features = bool(motion_features)
+        if self.motion_features and obs_size != OBS_SIZE:
+            raise ValueError(f"motion_features reads the {OBS_SIZE}-number observation, got {obs_size} inputs")
+        weights = motion_feature_weights() if self.motion_features else np.zeros((obs_size, 0), np.float32)
+        self.register_buffer("weights", torch.from_numpy(weights), persistent=False)
+        self.size = obs_size + weights.shape[1]
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        if not self.motion_features:
+            return obs
+        return torch.cat([obs, obs @ self.weights], dim=-1)
+
+
 class Actor(nn.Module):
     """Deterministic policy: observation -> action in [-1, 1]^action_size."""
 
     def __init__(self, obs_size: int, action_size: int, hidden=(256, 256), residual_scale: float = 0.0, base=None,
-                 turn_lead: float = 0.0):
+                 turn_lead: float = 0.0, motion_features: bool = False):
         super().__init__()
-        self.norm = Standardizer(obs_size)
-        self.net = mlp([obs_size, *hidden], action_size)
+        self.inputs = NetworkInputs(obs_size, motion_features)
+        self.norm = Standardizer(self.inputs.size)
+        self.net = mlp([self.inputs.size, *hidden], action_size)
         self.residual_scale = float(residual_scale)
         if not 0.0 <= self.residual_scale <= 2.0:
             raise ValueError(f"residual_scale must be in [0, 2], got {residual_scale}")
@@ -94,7 +120,7 @@ class Actor(nn.Module):
         return base + torch.cat([shift, torch.zeros_like(shift)], dim=-1)
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        out = torch.tanh(self.net(self.norm(obs)))
+        out = torch.tanh(self.net(self.norm(self.inputs(obs))))
         if self.residual_scale > 0:
             return torch.clamp(self.base_action(obs) + self.residual_scale * out, -1.0, 1.0)
         return out
@@ -106,14 +132,16 @@ class Actor(nn.Module):
 class DistributionalCritic(nn.Module):
     """(observation, action) -> logits of a categorical value distribution over fixed atoms."""
 
-    def __init__(self, obs_size: int, action_size: int, num_atoms: int, v_min: float, v_max: float, hidden=(256, 256)):
+    def __init__(self, obs_size: int, action_size: int, num_atoms: int, v_min: float, v_max: float, hidden=(256, 256),
+                 motion_features: bool = False):
         super().__init__()
-        self.norm = Standardizer(obs_size)
-        self.net = mlp([obs_size + action_size, *hidden], num_atoms)
+        self.inputs = NetworkInputs(obs_size, motion_features)
+        self.norm = Standardizer(self.inputs.size)
+        self.net = mlp([self.inputs.size + action_size, *hidden], num_atoms)
         self.register_buffer("atoms", torch.linspace(v_min, v_max, num_atoms))
 
     def forward(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
-        return self.net(torch.cat([self.norm(obs), action], dim=-1))
+        return self.net(torch.cat([self.norm(self.inputs(obs)), action], dim=-1))
 
     def q_value(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
         return (torch.softmax(self(obs, action), dim=-1) * self.atoms).sum(-1)

@@ -37,8 +37,9 @@ from lbgp.agent.networks import Actor
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
-VERSION = 3  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base
-READABLE = (1, 2, 3)
+VERSION = 4  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
+# 4: the motion-feature inputs
+READABLE = (1, 2, 3, 4)
 GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
 MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
@@ -104,6 +105,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "hidden": list(hidden),
             "residual_scale": float(residual_scale),
             "turn_lead": float(actor.turn_lead),
+            "motion_features": bool(actor.inputs.motion_features),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },
@@ -128,7 +130,8 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bo
     expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
         actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]),
-                      residual_scale=float(data.get("residual_scale", 0.0)), turn_lead=float(data.get("turn_lead", 0.0)))
+                      residual_scale=float(data.get("residual_scale", 0.0)), turn_lead=float(data.get("turn_lead", 0.0)),
+                      motion_features=bool(data.get("motion_features", False)))
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}
         weights = dict(data["actor"])
         if data["version"] == 1:  # no standardisation, plain actor: identity buffers

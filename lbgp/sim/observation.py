@@ -136,6 +136,30 @@ def turn_rate_weights(frames: int = TURN_RATE_FRAMES) -> np.ndarray:
     return w.astype(np.float32)
 
 
+MOTION_FEATURES = ("person_vx", "person_vy", "person_turn_rate", "robot_vx", "robot_vy")
+VELOCITY_FRAMES = 2  # past person frames (0.4 s) in the person-velocity estimate below
+
+
+def motion_feature_weights() -> np.ndarray:
+    """Weights W (SIZE, 5) with ``obs @ W`` = motion estimates read linearly off a scaled
+    observation, in the current person frame (x ahead, y left), SI units: the person's velocity
+    (m/s; least-squares slope through the origin of their last ``VELOCITY_FRAMES`` past positions:
+    a person walking at v was at -v * i * FRAME_PERIOD i frames ago), their turn rate (rad/s,
+    ``turn_rate_weights``) and the robot's velocity over the ground expressed in the current
+    person frame (m/s; its last frame-to-frame displacement). The stacked frames already hold all of this; an optional actor
+    and critic input (``D4PGConfig.motion_features``) that spares the network learning the
+    differences. Linear, so numpy and torch alike; the mirror image's y velocities and turn rate are
+    the negatives."""
+    w = np.zeros((SIZE, len(MOTION_FEATURES)))
+    i = np.arange(1, VELOCITY_FRAMES + 1)
+    rows = 3 + 6 * (i - 1)  # z^h_{t-i}: person i frames ago
+    w[rows, 0] = w[rows + 1, 1] = -i * POSITION_SCALE / (np.sum(i * i) * FRAME_PERIOD)
+    w[:, 2] = turn_rate_weights()
+    w[0, 3] = w[1, 4] = POSITION_SCALE / FRAME_PERIOD  # z^r_t - z^r_{t-1}
+    w[6, 3] = w[7, 4] = -POSITION_SCALE / FRAME_PERIOD
+    return w.astype(np.float32)
+
+
 def unscale(obs: np.ndarray) -> np.ndarray:
     """Metric relative states back from a (noise-free, unclipped) observation vector."""
     return (np.asarray(obs, dtype=float).reshape(-1, 3) / _INV_SCALE).ravel()

@@ -130,10 +130,18 @@ def turn_rate_weights(frames: int = TURN_RATE_FRAMES) -> np.ndarray:
     torch tensors alike, one observation or a batch; the mirror image's turn rate is its negative."""
     if not 1 <= frames < FRAMES:
         raise ValueError(f"the turn-rate estimate uses 1 to {FRAMES - 1} past frames, got {frames}")
-    i = np.arange(1, frames + 1, dtype=float)
+    return _person_slope_weights(2, frames, ANGLE_SCALE).astype(np.float32)
+
+
+def _person_slope_weights(component: int, frames: int, scale: float) -> np.ndarray:
+    """Weights (SIZE,) of the least-squares slope through the origin, per second, of the person's
+    past ``component`` (0: x, 1: y, 2: heading; scaled by ``scale``) over the last ``frames``
+    frames, in the current person frame, where the person now is the origin: a quantity that
+    changes at rate r was -r * i * FRAME_PERIOD i frames ago."""
+    i = np.arange(1, frames + 1)
     w = np.zeros(SIZE)
-    w[3 + 6 * (i.astype(int) - 1) + 2] = -i * ANGLE_SCALE / (np.sum(i * i) * FRAME_PERIOD)
-    return w.astype(np.float32)
+    w[3 + 6 * (i - 1) + component] = -i * scale / (np.sum(i * i) * FRAME_PERIOD)
+    return w
 
 
 MOTION_FEATURES = ("person_vx", "person_vy", "person_turn_rate", "robot_vx", "robot_vy")
@@ -143,17 +151,16 @@ VELOCITY_FRAMES = 2  # past person frames (0.4 s) in the person-velocity estimat
 def motion_feature_weights() -> np.ndarray:
     """Weights W (SIZE, 5) with ``obs @ W`` = motion estimates read linearly off a scaled
     observation, in the current person frame (x ahead, y left), SI units: the person's velocity
-    (m/s; least-squares slope through the origin of their last ``VELOCITY_FRAMES`` past positions:
-    a person walking at v was at -v * i * FRAME_PERIOD i frames ago), their turn rate (rad/s,
-    ``turn_rate_weights``) and the robot's velocity over the ground expressed in the current
-    person frame (m/s; its last frame-to-frame displacement). The stacked frames already hold all of this; an optional actor
+    (m/s; the slope of their last ``VELOCITY_FRAMES`` past positions, as ``turn_rate_weights``
+    takes the slope of their headings), their turn rate (rad/s, ``turn_rate_weights``) and the
+    robot's velocity over the ground expressed in the current person frame (m/s; its last
+    frame-to-frame displacement). The stacked frames already hold all of this; an optional actor
     and critic input (``D4PGConfig.motion_features``) that spares the network learning the
     differences. Linear, so numpy and torch alike; the mirror image's y velocities and turn rate are
     the negatives."""
     w = np.zeros((SIZE, len(MOTION_FEATURES)))
-    i = np.arange(1, VELOCITY_FRAMES + 1)
-    rows = 3 + 6 * (i - 1)  # z^h_{t-i}: person i frames ago
-    w[rows, 0] = w[rows + 1, 1] = -i * POSITION_SCALE / (np.sum(i * i) * FRAME_PERIOD)
+    w[:, 0] = _person_slope_weights(0, VELOCITY_FRAMES, POSITION_SCALE)
+    w[:, 1] = _person_slope_weights(1, VELOCITY_FRAMES, POSITION_SCALE)
     w[:, 2] = turn_rate_weights()
     w[0, 3] = w[1, 4] = POSITION_SCALE / FRAME_PERIOD  # z^r_t - z^r_{t-1}
     w[6, 3] = w[7, 4] = -POSITION_SCALE / FRAME_PERIOD

@@ -101,7 +101,8 @@ def cmd_train(args) -> int:
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
         )
         given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
-                 "mirror_augment": True if args.mirror_augment else None, "motion_features": True if args.motion_features else None}
+                 "mirror_augment": True if args.mirror_augment else None, "motion_features": True if args.motion_features else None,
+                 "previous_goal": True if args.previous_goal else None}
         if args.randomize:
             from lbgp.dynamics import load_randomization
 
@@ -366,6 +367,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also store every transition's mirror image (about the person's heading line) in the replay")
     p.add_argument("--motion-features", action="store_true",
                    help="actor and critic also see the person's velocity and turn rate and the robot's velocity, read off the observation")
+    p.add_argument("--previous-goal", action="store_true",
+                   help="actor and critic also see the action sent one step before (the previous goal); the policy carries it")
     p.add_argument("--paper", action="store_true",
                    help="the paper's plain D4PG configuration: tanh actor on raw inputs, white noise 0.3, uniform spawns, no goal prior")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],

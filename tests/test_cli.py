@@ -109,6 +109,16 @@ def test_train_mirror_augment_flag_reaches_the_run_config(tmp_path):
     assert json.loads((run / "config.json").read_text())["mirror_augment"] is True
 
 
+def test_train_previous_goal_flag_reaches_the_run_config_and_the_policy_file(tmp_path):
+    from lbgp.agent.policy import load_policy
+
+    run = tmp_path / "run"
+    assert main(["train", "--previous-goal", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    assert json.loads((run / "config.json").read_text())["previous_goal"] is True
+    policy = load_policy(run / "policy.pt")
+    assert policy.previous_goal and policy.actor.obs_size == 59
+
+
 def test_train_turn_lead_reaches_the_run_config_and_the_policy_file(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--turn-lead", "0.4", "--paper", "--out", str(run)]) == 2

@@ -20,7 +20,7 @@ from lbgp.agent.config import D4PGConfig
 from lbgp.agent.learner import make_actor
 from lbgp.agent.networks import Actor
 from lbgp.agent.nstep import NStepAccumulator
-from lbgp.sim import observation as obs_lib
+from lbgp.agent.previous_goal import agent_input, agent_input_size
 from lbgp.sim.tasks import CURRICULUM
 
 ACTION_SIZE = 2
@@ -94,23 +94,30 @@ class ExplorationNoise:
 
 def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.random.Generator, nstep: NStepAccumulator, refresh=None):
     """One episode; returns (n-step transition batch, return, steps). ``refresh()`` is called every
-    ``weight_sync_steps`` steps so that long episodes pick up new weights."""
+    ``weight_sync_steps`` steps so that long episodes pick up new weights. With
+    ``cfg.previous_goal`` the transitions hold agent inputs (observation + the action sent before)."""
     transitions, episode_return, steps = [], 0.0, 0
     nstep.reset()
     timestep = env.reset()
     noise = ExplorationNoise(cfg.sigma, cfg.noise_correlation, rng)
+    sent = actor.base.numpy().astype(np.float32)  # "the previous action" at the first step
+
+    def inputs(observation):
+        return agent_input(observation, sent) if cfg.previous_goal else observation
+
     while not timestep.last():
-        obs = timestep.observation
+        obs = inputs(timestep.observation)
         with torch.no_grad():
             action = actor(torch.from_numpy(obs)[None])[0].numpy()
         if exploring:
             action = np.clip(action + noise.sample(), -1.0, 1.0).astype(np.float32)
         timestep = env.step(action)
+        sent = np.asarray(action, np.float32)
         episode_return += timestep.reward
         steps += 1
         terminal = timestep.last() and timestep.discount == 0.0
         truncated = timestep.last() and not terminal
-        transitions += nstep.step(obs, action, timestep.reward, timestep.observation, terminal, truncated)
+        transitions += nstep.step(obs, action, timestep.reward, inputs(timestep.observation), terminal, truncated)
         if refresh is not None and steps % cfg.weight_sync_steps == 0:
             refresh()
     batch = tuple(np.array([t[i] for t in transitions], np.float32) for i in range(5))
@@ -144,7 +151,7 @@ def run_actor(spec: ActorSpec, cfg_dict: dict, board: WeightBoard, level_index, 
         queue.cancel_join_thread()  # never hang at exit on a queue nobody reads any more
     parent = mp.parent_process()
     rng = np.random.default_rng(spec.seed)
-    actor = make_actor(cfg, obs_lib.SIZE, ACTION_SIZE)
+    actor = make_actor(cfg, agent_input_size(cfg.previous_goal), ACTION_SIZE)
     version = -1
     envs = EnvCache(cfg, rng)
     nstep = NStepAccumulator(cfg.n_step, cfg.discount)

@@ -69,6 +69,8 @@ class D4PGConfig:
     motion_features: bool = False  # actor and critic also see the person's velocity and turn rate and the
     # robot's velocity, read linearly off the observation (lbgp.sim.observation.motion_feature_weights);
     # the observation itself, and so the deploy loop, is unchanged. Off: measured over 3 seeds, docs/training.md
+    previous_goal: bool = False  # actor and critic also see the action sent one step before (the previous
+    # goal; lbgp.agent.previous_goal): the policy's only memory, carried by Policy between act calls
     normalize_obs: bool = True  # standardise the observation (mean/std of the first min_replay transitions)
     randomize: dict = dataclasses.field(default_factory=dict)  # domain randomisation ranges per episode
     # (lbgp.dynamics.Randomization as a dict; `lbgp train --randomize PRESET|FILE` fills it); {}: none
@@ -122,7 +124,7 @@ class D4PGConfig:
     def paper(cls, **overrides) -> "D4PGConfig":
         """The paper's plain configuration (`lbgp train --paper`): tanh actor on the raw observation,
         no goal prior, uniform spawns, white exploration noise of 0.3, batch 128, one update per step."""
-        plain = dict(residual_scale=0.0, turn_lead=0.0, motion_features=False, normalize_obs=False, spawn_front_share=0.5, noise_correlation=0.0,
+        plain = dict(residual_scale=0.0, turn_lead=0.0, motion_features=False, previous_goal=False, normalize_obs=False, spawn_front_share=0.5, noise_correlation=0.0,
                      sigma=0.3, prior_weight=0.0, batch_size=128, max_updates_per_step=1.0,
                      actor_warmup_updates=0)
         return cls(**{**plain, **overrides})

@@ -14,7 +14,8 @@ from lbgp.agent.networks import Actor, DistributionalCritic
 
 
 def make_actor(cfg: D4PGConfig, obs_size: int, action_size: int) -> Actor:
-    """The actor a config asks for (the learner's and every actor process's)."""
+    """The actor a config asks for (the learner's and every actor process's); ``obs_size``: the agent
+    input's (``lbgp.agent.previous_goal.agent_input_size``)."""
     base = action_from_goal(DESIRED_GOAL) if cfg.actor_residual_scale > 0 else None
     return Actor(obs_size, action_size, cfg.hidden, residual_scale=cfg.actor_residual_scale, base=base,
                  turn_lead=cfg.turn_lead if cfg.actor_residual_scale > 0 else 0.0, motion_features=cfg.motion_features)

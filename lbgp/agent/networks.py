@@ -21,6 +21,9 @@ With ``motion_features`` both networks also see five motion estimates read linea
 observation (the person's velocity and turn rate, the robot's velocity; ``motion_feature_weights``),
 appended to it before the standardisation: nothing the stacked frames do not hold, only
 differences the network need not learn.
+
+Both take ``obs_size`` inputs: the 57-number observation, or 59 with the previous action after it
+(``previous_goal``, ``lbgp.agent.previous_goal``).
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from torch import nn
 
 from lbgp.actions import GOAL_X
 from lbgp.sim.observation import SIZE as OBS_SIZE
-from lbgp.sim.observation import motion_feature_weights, turn_rate_weights
+from lbgp.sim.observation import MOTION_FEATURES, motion_feature_weights, turn_rate_weights
 
 MIN_OBS_STD = 0.01  # floor of the standardisation's std (scaled units: 6 cm, 1.8 deg): pure-noise
 # dimensions are not blown up
@@ -70,9 +73,11 @@ class NetworkInputs(nn.Module):
     def __init__(self, obs_size: int, motion_features: bool = False):
         super().__init__()
         self.motion_features = bool(motion_features)
-        if self.motion_features and obs_size != OBS_SIZE:
-            raise ValueError(f"motion_features reads the {OBS_SIZE}-number observation, got {obs_size} inputs")
-        weights = motion_feature_weights() if self.motion_features else np.zeros((obs_size, 0), np.float32)
+        if self.motion_features and obs_size < OBS_SIZE:
+            raise ValueError(f"motion_features reads the {OBS_SIZE}-number observation (and any inputs after it), got {obs_size} inputs")
+        weights = np.zeros((obs_size, len(MOTION_FEATURES) if self.motion_features else 0), np.float32)
+        if self.motion_features:  # read off the observation; extra inputs after it (the previous action) get no weight
+            weights[:OBS_SIZE] = motion_feature_weights()
         self.register_buffer("weights", torch.from_numpy(weights), persistent=False)
         self.size = obs_size + weights.shape[1]
 
@@ -88,6 +93,7 @@ class Actor(nn.Module):
     def __init__(self, obs_size: int, action_size: int, hidden=(256, 256), residual_scale: float = 0.0, base=None,
                  turn_lead: float = 0.0, motion_features: bool = False):
         super().__init__()
+        self.obs_size = int(obs_size)  # the observation, or more with the previous action (lbgp.agent.previous_goal)
         self.inputs = NetworkInputs(obs_size, motion_features)
         self.norm = Standardizer(self.inputs.size)
         self.net = mlp([self.inputs.size, *hidden], action_size)
@@ -103,7 +109,7 @@ class Actor(nn.Module):
         # obs @ lead = the base goal's extra x in action units (x action = 2 (x - GOAL_X[0]) / span - 1)
         lead = np.zeros((obs_size, 1), np.float32)
         if self.turn_lead > 0:
-            lead[:, 0] = turn_rate_weights() * self.turn_lead * 2.0 / (GOAL_X[1] - GOAL_X[0])
+            lead[:OBS_SIZE, 0] = turn_rate_weights() * self.turn_lead * 2.0 / (GOAL_X[1] - GOAL_X[0])
         self.register_buffer("_lead", torch.from_numpy(lead), persistent=False)
         if self.residual_scale > 0:
             last = self.net[-1]

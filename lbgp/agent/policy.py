@@ -24,6 +24,10 @@ straight behind the person, passing means choosing a side, which an equivariant 
 prefer (its lateral goal is zero in a state that is its own mirror image); the real-world
 protocol's behind starts lose what the shipped actor's side preference had won there
 (docs/training.md).
+
+A policy trained with the previous goal as an input (``lbgp.agent.previous_goal``) remembers the
+action it returned last and feeds it back with the next observation; ``reset()`` (called by every
+rollout and by ``lbgp deploy`` at each start) forgets it. Its mirror averaging mirrors that action too.
 """
 
 from __future__ import annotations
@@ -34,12 +38,13 @@ import torch
 from lbgp.actions import action_from_goal, goal_from_action, mirror_action
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.agent.networks import Actor
+from lbgp.agent.previous_goal import agent_input, agent_input_size, mirror_input
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
-VERSION = 4  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
-# 4: the motion-feature inputs
-READABLE = (1, 2, 3, 4)
+VERSION = 5  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
+# 4: the motion-feature inputs; 5: the previous goal as an input
+READABLE = (1, 2, 3, 4, 5)
 GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
 MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
@@ -71,24 +76,30 @@ class Policy:
         # only a residual goal policy has a base goal to shrink toward
         self.goal_deadband = float(goal_deadband) if self.actor.residual_scale > 0 and self.control == "goal" else 0.0
         self.mirror_average = bool(mirror_average)
+        self.previous_goal = self.actor.obs_size == agent_input_size(True)  # the actor reads its last action
+        self._previous = None
 
     def reset(self) -> None:
-        pass
+        """Start of an episode or run: forget the previous action."""
+        self._previous = None
 
     @torch.no_grad()
     def act(self, observation) -> np.ndarray:
         obs = np.asarray(observation, np.float32)
         if obs.shape != (obs_lib.SIZE,):
             raise ValueError(f"policy expects an observation of shape ({obs_lib.SIZE},), got {obs.shape}")
+        if self.previous_goal:
+            obs = agent_input(obs, self.actor.base.numpy() if self._previous is None else self._previous)
         if self.mirror_average:
-            own, of_mirror = self.actor(torch.from_numpy(np.stack([obs, obs_lib.mirror(obs)]))).numpy()
+            own, of_mirror = self.actor(torch.from_numpy(np.stack([obs, mirror_input(obs)]))).numpy()
             action = (0.5 * (own + mirror_action(of_mirror))).astype(np.float32)
         else:
             action = self.actor(torch.from_numpy(obs)[None])[0].numpy()
         if self.goal_deadband > 0.0:
             # the base of the observation and of its mirror image agree (it has no lateral part)
             base = self.actor.base_action(torch.from_numpy(obs)[None])[0].numpy()
-            return shrink_residual(action, base, self.goal_deadband)
+            action = shrink_residual(action, base, self.goal_deadband)
+        self._previous = np.array(action, np.float32)
         return action
 
 
@@ -106,6 +117,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "residual_scale": float(residual_scale),
             "turn_lead": float(actor.turn_lead),
             "motion_features": bool(actor.inputs.motion_features),
+            "previous_goal": actor.obs_size == agent_input_size(True),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },
@@ -129,7 +141,8 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bo
         raise ValueError(f"{path}: unknown policy method {data.get('method')!r} (expected an lbgp policy for method lbgp or e2e)")
     expected = f"an lbgp policy ({data.get('method')}) with {obs_lib.SIZE} inputs and 2 outputs"
     try:
-        actor = Actor(int(data["obs_size"]), int(data["action_size"]), tuple(int(h) for h in data["hidden"]),
+        inputs = agent_input_size(bool(data.get("previous_goal", False)))  # obs_size is checked above
+        actor = Actor(inputs, int(data["action_size"]), tuple(int(h) for h in data["hidden"]),
                       residual_scale=float(data.get("residual_scale", 0.0)), turn_lead=float(data.get("turn_lead", 0.0)),
                       motion_features=bool(data.get("motion_features", False)))
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}

@@ -6,18 +6,19 @@ import numpy as np
 import torch
 
 from lbgp.actions import mirror_actions
-from lbgp.sim.observation import mirror
+from lbgp.agent.previous_goal import mirror_input
 
 FIELDS = ("obs", "action", "ret", "discount", "next_obs")
 
 
 def mirrored(batch):
     """The mirror images of a batch of n-step transitions ``(obs, action, ret, discount, next_obs)``
-    about the person's heading line: observations by ``lbgp.sim.observation.mirror``, actions by
+    about the person's heading line: observations by ``lbgp.sim.observation.mirror`` (with the
+    previous action, if they hold one, mirrored as an action), actions by
     ``lbgp.actions.mirror_actions``; the reward depends on distance and |alpha| only, so returns
     and discounts stay."""
     obs, action, ret, discount, next_obs = batch
-    return mirror(obs), mirror_actions(action), ret, discount, mirror(next_obs)
+    return mirror_input(obs), mirror_actions(action), ret, discount, mirror_input(next_obs)
 
 
 class ReplayBuffer:

@@ -205,6 +205,47 @@ def test_a_bad_timestamp_blocks_good_data_for_at_most_the_reanchor_time(fault):
     assert all(status == "ok" for t, status in sink.sent if max(blocked) < t < 4.0 - 1e-9)  # driving again
 
 
+class GappedPoses:
+    """Good poses every tick except for ``gap`` (a mocap dropout); the robot stands 2 m ahead."""
+
+    def __init__(self, gap):
+        self.gap = gap
+
+    def poll(self, now, timeout=0.0):
+        if self.gap[0] <= now < self.gap[1]:
+            return []
+        return [PoseFrame(now, np.array([0.0, 0.0, 0.0]), np.array([-2.0, 0.0, 0.0]), now)]
+
+
+class ResetCountingPolicy(ConstantGoalPolicy):
+    """The goal ahead, counting ``reset`` calls and the ``act`` calls made since the last one."""
+
+    def __init__(self):
+        super().__init__()
+        self.resets, self.acts_since_reset = [], 0
+
+    def reset(self):
+        self.resets.append(self.acts_since_reset)
+        self.acts_since_reset = 0
+
+    def act(self, observation):
+        self.acts_since_reset += 1
+        return super().act(observation)
+
+
+@pytest.mark.parametrize("gap_s, resets", [(0.5, 1), (1.5, 2)])
+def test_the_policy_is_reset_at_the_start_and_after_a_gap_longer_than_the_reanchor_time(gap_s, resets):
+    """A stateful policy (``lbgp train --previous-goal`` remembers its last goal) starts afresh where
+    the observation history does: at the first good frame and after a dropout over ``reanchor_after``."""
+    policy = ResetCountingPolicy()
+    loop = DeployLoop(GappedPoses((1.0, 1.0 + gap_s)), Recorder(), policy, DeployConfig(max_duration=4.0), clock=ReplayClock())
+    assert (gap_s > loop.cfg.safety.reanchor_after) == (resets == 2)  # the two gaps lie either side of it
+    loop.run()
+    assert len(policy.resets) == resets
+    assert policy.resets[0] == 0 and all(n >= 4 for n in policy.resets[1:])  # the second one after a second of acting
+    assert policy.acts_since_reset >= 4
+
+
 # ---------------------------------------------------------------- damaged logs
 @pytest.fixture(scope="module")
 def small_log(tmp_path_factory):

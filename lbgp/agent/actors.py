@@ -20,7 +20,7 @@ from lbgp.agent.config import D4PGConfig
 from lbgp.agent.learner import make_actor
 from lbgp.agent.networks import Actor
 from lbgp.agent.nstep import NStepAccumulator
-from lbgp.agent.previous_goal import agent_input, agent_input_size
+from lbgp.agent.previous_goal import agent_input, agent_input_size, first_previous_action
 from lbgp.sim.tasks import CURRICULUM
 
 ACTION_SIZE = 2
@@ -100,13 +100,13 @@ def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.ra
     nstep.reset()
     timestep = env.reset()
     noise = ExplorationNoise(cfg.sigma, cfg.noise_correlation, rng)
-    sent = actor.base.numpy().astype(np.float32)  # "the previous action" at the first step
+    sent = first_previous_action(actor)
 
     def inputs(observation):
         return agent_input(observation, sent) if cfg.previous_goal else observation
 
+    obs = inputs(timestep.observation)
     while not timestep.last():
-        obs = inputs(timestep.observation)
         with torch.no_grad():
             action = actor(torch.from_numpy(obs)[None])[0].numpy()
         if exploring:
@@ -117,7 +117,9 @@ def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.ra
         steps += 1
         terminal = timestep.last() and timestep.discount == 0.0
         truncated = timestep.last() and not terminal
-        transitions += nstep.step(obs, action, timestep.reward, inputs(timestep.observation), terminal, truncated)
+        next_obs = inputs(timestep.observation)
+        transitions += nstep.step(obs, action, timestep.reward, next_obs, terminal, truncated)
+        obs = next_obs
         if refresh is not None and steps % cfg.weight_sync_steps == 0:
             refresh()
     batch = tuple(np.array([t[i] for t in transitions], np.float32) for i in range(5))

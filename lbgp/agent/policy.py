@@ -38,7 +38,7 @@ import torch
 from lbgp.actions import action_from_goal, goal_from_action, mirror_action
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.agent.networks import Actor
-from lbgp.agent.previous_goal import agent_input, agent_input_size, mirror_input
+from lbgp.agent.previous_goal import agent_input, agent_input_size, first_previous_action, mirror_input, reads_previous_action
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
@@ -76,7 +76,7 @@ class Policy:
         # only a residual goal policy has a base goal to shrink toward
         self.goal_deadband = float(goal_deadband) if self.actor.residual_scale > 0 and self.control == "goal" else 0.0
         self.mirror_average = bool(mirror_average)
-        self.previous_goal = self.actor.obs_size == agent_input_size(True)  # the actor reads its last action
+        self.previous_goal = reads_previous_action(self.actor)
         self._previous = None
 
     def reset(self) -> None:
@@ -89,7 +89,7 @@ class Policy:
         if obs.shape != (obs_lib.SIZE,):
             raise ValueError(f"policy expects an observation of shape ({obs_lib.SIZE},), got {obs.shape}")
         if self.previous_goal:
-            obs = agent_input(obs, self.actor.base.numpy() if self._previous is None else self._previous)
+            obs = agent_input(obs, first_previous_action(self.actor) if self._previous is None else self._previous)
         if self.mirror_average:
             own, of_mirror = self.actor(torch.from_numpy(np.stack([obs, mirror_input(obs)]))).numpy()
             action = (0.5 * (own + mirror_action(of_mirror))).astype(np.float32)
@@ -117,7 +117,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "residual_scale": float(residual_scale),
             "turn_lead": float(actor.turn_lead),
             "motion_features": bool(actor.inputs.motion_features),
-            "previous_goal": actor.obs_size == agent_input_size(True),
+            "previous_goal": reads_previous_action(actor),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },

@@ -27,6 +27,16 @@ def agent_input_size(previous_goal: bool) -> int:
     return obs_lib.SIZE + (ACTION_SIZE if previous_goal else 0)
 
 
+def reads_previous_action(actor) -> bool:
+    """Whether an actor (``lbgp.agent.networks.Actor``) was built for agent inputs with the previous action."""
+    return actor.obs_size == agent_input_size(True)
+
+
+def first_previous_action(actor) -> np.ndarray:
+    """What an episode's first step feeds back, in training and in acting alike: the actor's base."""
+    return actor.base.numpy().astype(np.float32)
+
+
 def agent_input(observation, previous_action) -> np.ndarray:
     """The observation followed by the previous action (one of each, or batches of both)."""
     obs = np.asarray(observation, np.float32)

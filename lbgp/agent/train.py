@@ -108,8 +108,9 @@ class Trainer:
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         self.rng = np.random.default_rng(cfg.seed)
-        self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
-        self.replay = ReplayBuffer(cfg.replay_capacity, agent_input_size(cfg.previous_goal), 2)
+        inputs = agent_input_size(cfg.previous_goal)
+        self.learner = D4PGLearner(cfg, inputs, 2)
+        self.replay = ReplayBuffer(cfg.replay_capacity, inputs, 2)
         self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps,
                                      cfg.curriculum_window, cfg.time_limit_s)
         self.env_steps = 0

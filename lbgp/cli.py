@@ -102,7 +102,7 @@ def cmd_train(args) -> int:
         )
         given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
                  "mirror_augment": True if args.mirror_augment else None, "motion_features": True if args.motion_features else None,
-                 "previous_goal": True if args.previous_goal else None}
+                 "previous_goal": True if args.previous_goal else None, "policy_average": args.policy_average}
         if args.randomize:
             from lbgp.dynamics import load_randomization
 
@@ -369,6 +369,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="actor and critic also see the person's velocity and turn rate and the robot's velocity, read off the observation")
     p.add_argument("--previous-goal", action="store_true",
                    help="actor and critic also see the action sent one step before (the previous goal); the policy carries it")
+    p.add_argument("--policy-average", type=A.nonnegative_float, default=None, metavar="TAU",
+                   help="the policy file holds a moving average of the actor's weights, moved TAU toward it per update "
+                        "(e.g. 1e-4; default 0: the last actor); the last actor is kept as policy_last.pt")
     p.add_argument("--paper", action="store_true",
                    help="the paper's plain D4PG configuration: tanh actor on raw inputs, white noise 0.3, uniform spawns, no goal prior")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],

@@ -44,6 +44,10 @@ class D4PGConfig:
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
     target_tau: float = 0.0  # > 0: soft (Polyak) target update by this much every step instead of hard updates
+    policy_average: float = 0.0  # > 0: the policy file holds an exponential moving average of the actor's
+    # weights, moved this much toward the actor after every update from the end of the actor warm-up
+    # (1e-4: a window of ~10k updates); the run also keeps the last raw actor as policy_last.pt. Training
+    # itself (actors, targets, curve) is unchanged. 0: the policy file is the last actor (the paper)
     prior_weight: float = 1.0  # LBGP only (not in the paper): the actor loss adds this * |a - a_ahead|^2,
     # a_ahead = the goal 1.5 m ahead. Keeps goals near the sensible default wherever the critic has no
     # clear preference (without it the goals jump step to step); 0 = plain D4PG. E2E: always 0.
@@ -115,6 +119,8 @@ class D4PGConfig:
             raise ValueError("turn_lead moves a residual actor's base goal: it needs residual_scale > 0 (not --paper)")
         if not self.max_updates_per_step > 0:
             raise ValueError(f"max_updates_per_step must be > 0, got {self.max_updates_per_step}")
+        if not 0.0 <= self.policy_average < 1.0:
+            raise ValueError(f"policy_average must be in [0, 1), got {self.policy_average}")
         if not self.prior_weight >= 0:
             raise ValueError(f"prior_weight must be >= 0, got {self.prior_weight}")
         if self.n_step < 1 or not 0 < self.discount <= 1:

@@ -29,6 +29,8 @@ class D4PGLearner:
                                            motion_features=cfg.motion_features)
         self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
         self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)
+        # cfg.policy_average > 0: an exponential moving average of the actor's weights, for the policy file
+        self.average_actor = copy.deepcopy(self.actor).requires_grad_(False) if cfg.policy_average > 0 else None
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
         self.updates = 0
@@ -45,8 +47,9 @@ class D4PGLearner:
         with torch.no_grad():
             inputs = self.actor.inputs(torch.as_tensor(observations, dtype=torch.float32))
         mean, std = inputs.mean(0), inputs.std(0)
-        for net in (self.actor, self.target_actor, self.critic, self.target_critic):
-            net.set_obs_stats(mean, std)
+        for net in (self.actor, self.target_actor, self.critic, self.target_critic, self.average_actor):
+            if net is not None:
+                net.set_obs_stats(mean, std)
         self.obs_stats_set = True
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
@@ -69,6 +72,9 @@ class D4PGLearner:
             actor_loss.backward()
             torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
             self.actor_opt.step()
+            if self.average_actor is not None:
+                with torch.no_grad():
+                    torch._foreach_lerp_(list(self.average_actor.parameters()), list(self.actor.parameters()), self.cfg.policy_average)
 
         self.updates += 1
         if self.cfg.target_tau > 0:
@@ -100,6 +106,7 @@ class D4PGLearner:
             "critic_opt": self.critic_opt.state_dict(),
             "updates": torch.tensor(self.updates),
             "obs_stats_set": torch.tensor(self.obs_stats_set),
+            **({"average_actor": self.average_actor.state_dict()} if self.average_actor is not None else {}),
         }
 
     def load_state_dict(self, state: dict) -> None:
@@ -111,3 +118,10 @@ class D4PGLearner:
         self.critic_opt.load_state_dict(state["critic_opt"])
         self.updates = int(state["updates"])
         self.obs_stats_set = bool(state.get("obs_stats_set", True))
+        if self.average_actor is not None:
+            self.average_actor.load_state_dict(state["average_actor"] if "average_actor" in state else state["actor"])
+
+    @property
+    def policy_actor(self) -> Actor:
+        """The actor a run's policy file holds: the weight average with cfg.policy_average, else the actor."""
+        return self.average_actor if self.average_actor is not None else self.actor

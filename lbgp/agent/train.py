@@ -7,7 +7,9 @@ A run directory holds:
                       exploiting episode)
     checkpoint.pt     learner, replay, counters, curriculum and RNG state (atomic; every
                       ``checkpoint_every_s`` and at the end or on Ctrl-C / SIGTERM)
-    policy.pt         the final policy file (see lbgp.agent.policy)
+    policy.pt         the final policy file (see lbgp.agent.policy): the last actor, or with
+                      ``policy_average`` the moving average of its weights
+    policy_last.pt    with ``policy_average`` only: the last actor
     summary.json      final counters and returns
     run.lock          held by the training process that uses the folder (a second one is refused)
 
@@ -305,7 +307,11 @@ class Trainer:
             "final_exploit_return_mean_last20": float(np.mean(final_level)) if final_level else None,
             "interrupted": interrupted,
         }
-        save_policy(self.dir / "policy.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden, extra=summary,
+        if self.learner.average_actor is not None:  # the last raw actor too, beside the average
+            summary["policy_average"] = cfg.policy_average
+            save_policy(self.dir / "policy_last.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden,
+                        extra={**summary, "policy_average": 0.0}, residual_scale=cfg.actor_residual_scale)
+        save_policy(self.dir / "policy.pt", self.learner.policy_actor, cfg.method, cfg.robot, cfg.hidden, extra=summary,
                     residual_scale=cfg.actor_residual_scale)
         write_json(self.dir / "summary.json", summary)
         return summary

@@ -92,3 +92,15 @@ def test_a_tau_outside_0_to_1_is_refused():
         D4PGConfig(policy_average=1.0).validate()
     with pytest.raises(ValueError, match="policy_average"):
         D4PGConfig(policy_average=-0.1).validate()
+
+
+def test_soft_target_updates_move_both_targets_by_tau_through_the_same_average():
+    cfg = D4PGConfig(hidden=(8,), batch_size=16, actor_warmup_updates=0, target_tau=0.1)
+    learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
+    rng = np.random.default_rng(4)
+    learner.set_obs_stats(rng.uniform(-1, 1, (64, obs_lib.SIZE)).astype(np.float32))
+    before = {name: _params(getattr(learner, name)) for name in ("target_actor", "target_critic")}
+    learner.update(_batch(rng))
+    for name, net in (("target_actor", learner.actor), ("target_critic", learner.critic)):
+        for got, old, new in zip(_params(getattr(learner, name)), before[name], _params(net)):
+            torch.testing.assert_close(got, old + 0.1 * (new - old))

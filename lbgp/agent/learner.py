@@ -21,6 +21,12 @@ def make_actor(cfg: D4PGConfig, obs_size: int, action_size: int) -> Actor:
                  turn_lead=cfg.turn_lead if cfg.actor_residual_scale > 0 else 0.0, motion_features=cfg.motion_features)
 
 
+@torch.no_grad()
+def polyak_(average: torch.nn.Module, net: torch.nn.Module, tau: float) -> None:
+    """Move ``average``'s parameters ``tau`` of the way toward ``net``'s (in place)."""
+    torch._foreach_lerp_(list(average.parameters()), list(net.parameters()), tau)
+
+
 class D4PGLearner:
     def __init__(self, cfg: D4PGConfig, obs_size: int, action_size: int):
         self.cfg = cfg
@@ -73,14 +79,12 @@ class D4PGLearner:
             torch.nn.utils.clip_grad_norm_(self.actor.parameters(), self.cfg.grad_clip)
             self.actor_opt.step()
             if self.average_actor is not None:
-                with torch.no_grad():
-                    torch._foreach_lerp_(list(self.average_actor.parameters()), list(self.actor.parameters()), self.cfg.policy_average)
+                polyak_(self.average_actor, self.actor, self.cfg.policy_average)
 
         self.updates += 1
         if self.cfg.target_tau > 0:
-            with torch.no_grad():
-                for net, target in ((self.actor, self.target_actor), (self.critic, self.target_critic)):
-                    torch._foreach_lerp_(list(target.parameters()), list(net.parameters()), self.cfg.target_tau)
+            polyak_(self.target_actor, self.actor, self.cfg.target_tau)
+            polyak_(self.target_critic, self.critic, self.cfg.target_tau)
         elif self.updates % self.cfg.target_update_period == 0:
             self.target_actor.load_state_dict(self.actor.state_dict())
             self.target_critic.load_state_dict(self.critic.state_dict())

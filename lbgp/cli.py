@@ -369,7 +369,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="actor and critic also see the person's velocity and turn rate and the robot's velocity, read off the observation")
     p.add_argument("--previous-goal", action="store_true",
                    help="actor and critic also see the action sent one step before (the previous goal); the policy carries it")
-    p.add_argument("--policy-average", type=A.nonnegative_float, default=None, metavar="TAU",
+    p.add_argument("--policy-average", type=A.fraction, default=None, metavar="TAU",
                    help="the policy file holds a moving average of the actor's weights, moved TAU toward it per update "
                         "(e.g. 1e-4; default 0: the last actor); the last actor is kept as policy_last.pt")
     p.add_argument("--paper", action="store_true",

@@ -55,6 +55,14 @@ def nonnegative_float(text: str) -> float:
     return _bounded_float(text, 0.0, 1e7, True, "a number from 0 to 1e7")
 
 
+def fraction(text: str) -> float:
+    """A rate in [0, 1), where 0 means 'off' (documented per option)."""
+    value = _number(text, float)
+    if not 0.0 <= value < 1.0:
+        raise argparse.ArgumentTypeError(f"must be a number from 0 up to (not including) 1, got {value:g}")
+    return value
+
+
 def distance(text: str) -> float:
     return _bounded_float(text, 0.0, 10.0, False, "a distance above 0 and at most 10 m")
 

@@ -122,7 +122,7 @@ def test_train_previous_goal_flag_reaches_the_run_config_and_the_policy_file(tmp
 def test_train_policy_average_reaches_the_run_config_and_writes_both_policies(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--policy-average", "1.5", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 2
-    assert "policy_average" in capsys.readouterr().err and not run.exists()
+    assert "--policy-average" in capsys.readouterr().err and not run.exists()
     assert main(["train", "--policy-average", "1e-4", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
     assert json.loads((run / "config.json").read_text())["policy_average"] == 1e-4
     assert (run / "policy.pt").is_file() and (run / "policy_last.pt").is_file()

@@ -1,9 +1,9 @@
 """Every bad input to the ``lbgp`` command line ends with one line on stderr that names the
 problem, exit code 2, no traceback, and nothing written.
 
-``BAD_CASES`` enumerates 310 (subcommand, option, invalid value) cases over every option of every
+``BAD_CASES`` enumerates 317 (subcommand, option, invalid value) cases over every option of every
 subcommand that takes a value: counts (negative, zero, NaN, huge, empty, not a number, fractional), rates and
-durations (negative, NaN, infinite, empty, not a number), seeds (negative, too large, not an
+durations (negative, NaN, infinite, empty, not a number), fractions in [0, 1) (negative, 1, above 1, NaN, infinite, empty, not a number), seeds (negative, too large, not an
 integer), input files (missing, a directory, empty name), output files (a directory, under a
 regular file, empty name), output folders (a regular file, under a regular file) and run folders
 (missing, a file). ``test_every_bad_option_value_is_refused`` runs all of them (a test
@@ -32,6 +32,7 @@ SEED = ["-1", "4294967296", "x", "1.5", ""]
 POSITIVE = ["-1", "0", "nan", "inf", "", "x"]
 NONNEGATIVE = ["-1", "nan", "inf", "-inf", "", "x"]
 DISTANCE = ["0", "-1", "nan", "100", "x"]
+FRACTION = ["-0.1", "1", "1.5", "nan", "inf", "", "x"]  # a rate in [0, 1)
 
 # (subcommand words, option, kind); option None: a positional argument
 OPTIONS = [
@@ -67,9 +68,9 @@ OPTIONS = [
     (["sysid"], None, "infile"), (["sysid", "--excite"], "--log", "outfile"), (["sysid", "LOG"], "--out", "outfile"),
     (["sysid", "LOG"], "--png", "outfile"), (["sysid", "--excite"], "--seed", "seed"),
     (["evaluate"], "--goal-deadband", "nonneg"), (["deploy"], "--goal-deadband", "nonneg"),
-    (["train"], "--turn-lead", "nonneg"),
+    (["train"], "--turn-lead", "nonneg"), (["train"], "--policy-average", "fraction"),
 ]
-VALUES = {"count": COUNT, "seed": SEED, "positive": POSITIVE, "nonneg": NONNEGATIVE, "distance": DISTANCE,
+VALUES = {"count": COUNT, "seed": SEED, "positive": POSITIVE, "nonneg": NONNEGATIVE, "distance": DISTANCE, "fraction": FRACTION,
           "infile": ["MISSING", "DIR", ""], "outfile": ["DIR", "UNDER_FILE", ""], "outdir": ["FILE", "UNDER_FILE_DIR"],
           "rundir": ["MISSING", "FILE"]}
 BAD_CASES = [(words, option, value) for words, option, kind in OPTIONS for value in VALUES[kind]]
@@ -135,7 +136,7 @@ def test_the_case_list_covers_every_option_that_takes_a_value():
     covered = {(w[0] if w[0] != "experiment" else " ".join(w[:2]), o) for w, o, _ in OPTIONS}
     missing = set(walk(build_parser(), [])) - covered
     assert not missing, f"options without bad cases: {sorted(missing, key=str)}"
-    assert len(BAD_CASES) == 310  # the count quoted in the module docstring
+    assert len(BAD_CASES) == 317  # the count quoted in the module docstring
 
 
 @pytest.mark.parametrize("words,option,value", BAD_CASES, ids=[f"{' '.join(w)} {o} {v!r}" for w, o, v in BAD_CASES])

@@ -20,6 +20,10 @@ acting (lbgp.agent.policy.MIRROR_AVERAGE; the default keeps the plain name, the 
 ``<variant>@nomirror`` or ``<variant>@mirror``). The two choices combine: ``LBGP@deadband0@nomirror``
 is the actor's own raw answer.
 
+``--last-actor`` also scores, for every run trained with ``--policy-average`` (its folder keeps
+``policy_last.pt`` beside the averaged ``policy.pt``), the last actor as variant ``<variant>@last``:
+the paired control from the same training, its difference given per seed.
+
 ``--runs`` takes several folders and ``--variants`` picks variants, so that runs of another training
 choice kept elsewhere are compared with the ablation's LBGP runs on the same episodes, e.g. mirror
 augmentation in training (docs/training.md):
@@ -71,11 +75,14 @@ def seed_of(run: str) -> str:
     return run.rsplit("_s", 1)[1]
 
 
-def acting_run_name(run: str, deadband: float | None = None, mirror: bool = MIRROR_AVERAGE) -> str:
+def acting_run_name(run: str, deadband: float | None = None, mirror: bool = MIRROR_AVERAGE, last: bool = False) -> str:
     """``LBGP_s1`` acting with the defaults stays ``LBGP_s1``; at a 0 m dead band it is
     ``LBGP@deadband0_s1``, without mirror averaging ``LBGP@nomirror_s1`` (both:
-    ``LBGP@deadband0@nomirror_s1``). ``deadband`` None: the default."""
-    tags = "" if deadband is None or deadband == GOAL_DEADBAND_M else f"@deadband{deadband:g}"
+    ``LBGP@deadband0@nomirror_s1``). ``deadband`` None: the default. ``last``: the run's last actor
+    (``policy_last.pt``) instead of its policy file, ``LBGP@last_s1``."""
+    tags = "@last" if last else ""
+    if deadband is not None and deadband != GOAL_DEADBAND_M:
+        tags += f"@deadband{deadband:g}"
     if mirror != MIRROR_AVERAGE:
         tags += "@mirror" if mirror else "@nomirror"
     return f"{variant_of(run)}{tags}_s{seed_of(run)}" if tags else run
@@ -162,6 +169,8 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--deadbands", default=str(GOAL_DEADBAND_M), help="comma-separated goal dead bands (m) for the LBGP runs")
     ap.add_argument("--mirror", default="on" if MIRROR_AVERAGE else "off",
                     help="comma-separated on/off: score every run with and/or without mirror-averaged acting")
+    ap.add_argument("--last-actor", action="store_true",
+                    help="also score each run's policy_last.pt (runs trained with --policy-average) as <variant>@last")
     ap.add_argument("--resummarise", action="store_true",
                     help="no scoring: summarise the runs already in --json again (after a change to the summary only)")
     args = ap.parse_args(argv)
@@ -181,9 +190,14 @@ def main(argv: list[str] | None = None) -> dict:
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None)]
     for name, path in policies.items():
         e2e = variant_of(name) == "E2E"
-        for d in [None] if e2e else deadbands:
-            for m in mirrors:
-                jobs.append((acting_run_name(name, d, m), "e2e" if e2e else "lbgp", str(path), scenarios, args.episodes, args.seed, d, m))
+        files = {False: path}
+        if args.last_actor and (path.parent / "policy_last.pt").is_file():
+            files[True] = path.parent / "policy_last.pt"
+        for last, file in files.items():
+            for d in [None] if e2e else deadbands:
+                for m in mirrors:
+                    jobs.append((acting_run_name(name, d, m, last), "e2e" if e2e else "lbgp", str(file), scenarios,
+                                 args.episodes, args.seed, d, m))
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")

@@ -86,3 +86,22 @@ def test_runs_from_several_folders_and_chosen_variants(tmp_path):
     (b / "LBGP_s0" / "policy.pt").write_bytes(b"")
     with pytest.raises(ValueError, match="LBGP_s0 is in two folders"):
         run_policies([a, b])
+
+
+def test_last_actor_scores_a_policy_average_runs_last_actor_as_its_paired_control(tmp_path):
+    runs, kept = tmp_path / "runs", Path(__file__).resolve().parents[1] / "results" / "policy_average_runs"
+    (runs / "LBGP-policy-average_s0").mkdir(parents=True)
+    for name in ("policy.pt", "policy_last.pt"):
+        shutil.copy(kept / "LBGP-policy-average_s0" / name, runs / "LBGP-policy-average_s0" / name)
+    (runs / "LBGP_s0").mkdir()  # a run without policy_last.pt: no @last variant
+    shutil.copy(default_policy_path("lbgp"), runs / "LBGP_s0" / "policy.pt")
+    assert acting_run_name("LBGP-policy-average_s0", last=True) == "LBGP-policy-average@last_s0"
+    assert acting_run_name("LBGP_s1", 0.0, mirror=False, last=True) == "LBGP@last@deadband0@nomirror_s1"
+    result = main(["--runs", str(runs), "--scenarios", "turning_ahead", "--episodes", "1", "--last-actor",
+                   "--json", str(tmp_path / "out.json")])
+    assert sorted(result["runs"]) == ["LBGP-policy-average@last_s0", "LBGP-policy-average_s0", "LBGP_s0"]
+    last, average = result["runs"]["LBGP-policy-average@last_s0"], result["runs"]["LBGP-policy-average_s0"]
+    assert last["policy"].endswith("policy_last.pt") and average["policy"].endswith("policy.pt")
+    assert last["sum"] != average["sum"]  # two different actors on the same episode
+    paired = result["variants"]["LBGP-policy-average@last"]["minus_LBGP-policy-average_paired"]
+    assert paired["per_seed"] == [pytest.approx(last["sum"] - average["sum"], abs=2e-3)]

@@ -90,6 +90,15 @@ def cmd_train(args) -> int:
     from lbgp.agent.train import train
 
     if args.resume:
+        changed = [option for option, value in (("--set", args.set), ("--paper", args.paper), ("--actors", args.actors),
+                                                ("--prior-weight", args.prior_weight), ("--turn-lead", args.turn_lead),
+                                                ("--updates-per-step", args.updates_per_step), ("--randomize", args.randomize),
+                                                ("--mirror-augment", args.mirror_augment), ("--motion-features", args.motion_features),
+                                                ("--previous-goal", args.previous_goal), ("--policy-average", args.policy_average),
+                                                ("--no-curriculum", args.no_curriculum)) if value not in (None, False)]
+        if changed:
+            raise ValueError(f"--resume continues the run with its own config ({args.resume}/config.json); "
+                             f"{', '.join(changed)} would be ignored: drop it or start a new run with --out")
         cfg = D4PGConfig(total_steps=args.steps or 0, time_limit_s=(args.minutes or 0) * 60.0)
         summary = train(cfg, args.resume, resume=True, backend=args.backend)
     else:
@@ -107,6 +116,7 @@ def cmd_train(args) -> int:
             from lbgp.dynamics import load_randomization
 
             given["randomize"] = load_randomization(args.randomize).to_dict()
+        given.update(dict(args.set or []))  # --set NAME=VALUE, last one wins
         cfg = preset(**chosen, **{k: v for k, v in given.items() if v is not None}).validate()
         summary = train(cfg, args.out, backend=args.backend)
     print(json.dumps(summary, indent=2))
@@ -372,6 +382,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--policy-average", type=A.fraction, default=None, metavar="TAU",
                    help="the policy file holds a moving average of the actor's weights, moved TAU toward it per update "
                         "(e.g. 1e-4; default 0: the last actor); the last actor is kept as policy_last.pt")
+    p.add_argument("--set", type=A.training_setting, action="append", metavar="NAME=VALUE",
+                   help="change one training-config field that has no option of its own, over the preset "
+                        "(repeatable; e.g. spawn_front_share=0.5, noise_correlation=0, sigma=0.3; "
+                        "the fields: D4PGConfig.SETTABLE, docs/training.md)")
     p.add_argument("--paper", action="store_true",
                    help="the paper's plain D4PG configuration: tanh actor on raw inputs, white noise 0.3, uniform spawns, no goal prior")
     p.add_argument("--backend", default="processes", choices=["processes", "inline", "ray"],

@@ -137,3 +137,29 @@ def test_train_turn_lead_reaches_the_run_config_and_the_policy_file(tmp_path, ca
     from lbgp.agent.policy import load_policy
 
     assert load_policy(run / "policy.pt").actor.turn_lead == 0.4
+
+
+def test_train_set_changes_only_the_named_fields_over_the_preset(tmp_path):
+    run = tmp_path / "run"
+    assert main(["train", "--set", "spawn_front_share=0.5", "--set", "noise_correlation=0", "--set", "normalize_obs=off",
+                 "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    config = json.loads((run / "config.json").read_text())
+    assert config["spawn_front_share"] == 0.5 and config["noise_correlation"] == 0.0 and config["normalize_obs"] is False
+    assert config["sigma"] == 0.15 and config["residual_scale"] == 0.375  # the rest: the default preset's
+    paper = tmp_path / "paper"
+    assert main(["train", "--paper", "--set", "sigma=0.2", "--set", "sigma=0.1", "--set", "batch_size=64",
+                 "--steps", "40", "--backend", "inline", "--out", str(paper)]) == 0
+    config = json.loads((paper / "config.json").read_text())
+    assert config["sigma"] == 0.1 and config["batch_size"] == 64  # the last --set wins
+    assert config["residual_scale"] == 0.0 and config["spawn_front_share"] == 0.5  # the rest: the paper's
+
+
+def test_train_resume_refuses_options_it_would_ignore(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["train", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    before = {p.name: p.stat().st_mtime_ns for p in run.iterdir()}
+    for extra in (["--set", "sigma=0.3"], ["--paper"], ["--policy-average", "1e-4"]):
+        assert main(["train", "--resume", str(run), "--steps", "80", *extra]) == 2
+        err = capsys.readouterr().err
+        assert extra[0] in err and "config.json" in err
+    assert {p.name: p.stat().st_mtime_ns for p in run.iterdir()} == before  # nothing touched

@@ -1,9 +1,10 @@
 """Every bad input to the ``lbgp`` command line ends with one line on stderr that names the
 problem, exit code 2, no traceback, and nothing written.
 
-``BAD_CASES`` enumerates 317 (subcommand, option, invalid value) cases over every option of every
+``BAD_CASES`` enumerates 330 (subcommand, option, invalid value) cases over every option of every
 subcommand that takes a value: counts (negative, zero, NaN, huge, empty, not a number, fractional), rates and
-durations (negative, NaN, infinite, empty, not a number), fractions in [0, 1) (negative, 1, above 1, NaN, infinite, empty, not a number), seeds (negative, too large, not an
+durations (negative, NaN, infinite, empty, not a number), fractions in [0, 1) (negative, 1, above 1, NaN, infinite, empty, not a number), config settings
+(malformed, unknown or unsettable field, wrong type, out of range), seeds (negative, too large, not an
 integer), input files (missing, a directory, empty name), output files (a directory, under a
 regular file, empty name), output folders (a regular file, under a regular file) and run folders
 (missing, a file). ``test_every_bad_option_value_is_refused`` runs all of them (a test
@@ -33,6 +34,8 @@ POSITIVE = ["-1", "0", "nan", "inf", "", "x"]
 NONNEGATIVE = ["-1", "nan", "inf", "-inf", "", "x"]
 DISTANCE = ["0", "-1", "nan", "100", "x"]
 FRACTION = ["-0.1", "1", "1.5", "nan", "inf", "", "x"]  # a rate in [0, 1)
+SETTING = ["sigma", "=0.3", "sigma=", "nofield=1", "seed=3", "sigma=x", "sigma=nan", "sigma=-1", "batch_size=1.5",
+           "normalize_obs=maybe", "spawn_front_share=2", "n_step=0", ""]  # NAME=VALUE of a settable config field
 
 # (subcommand words, option, kind); option None: a positional argument
 OPTIONS = [
@@ -69,8 +72,9 @@ OPTIONS = [
     (["sysid", "LOG"], "--png", "outfile"), (["sysid", "--excite"], "--seed", "seed"),
     (["evaluate"], "--goal-deadband", "nonneg"), (["deploy"], "--goal-deadband", "nonneg"),
     (["train"], "--turn-lead", "nonneg"), (["train"], "--policy-average", "fraction"),
+    (["train"], "--set", "setting"),
 ]
-VALUES = {"count": COUNT, "seed": SEED, "positive": POSITIVE, "nonneg": NONNEGATIVE, "distance": DISTANCE, "fraction": FRACTION,
+VALUES = {"count": COUNT, "seed": SEED, "positive": POSITIVE, "nonneg": NONNEGATIVE, "distance": DISTANCE, "fraction": FRACTION, "setting": SETTING,
           "infile": ["MISSING", "DIR", ""], "outfile": ["DIR", "UNDER_FILE", ""], "outdir": ["FILE", "UNDER_FILE_DIR"],
           "rundir": ["MISSING", "FILE"]}
 BAD_CASES = [(words, option, value) for words, option, kind in OPTIONS for value in VALUES[kind]]
@@ -136,7 +140,7 @@ def test_the_case_list_covers_every_option_that_takes_a_value():
     covered = {(w[0] if w[0] != "experiment" else " ".join(w[:2]), o) for w, o, _ in OPTIONS}
     missing = set(walk(build_parser(), [])) - covered
     assert not missing, f"options without bad cases: {sorted(missing, key=str)}"
-    assert len(BAD_CASES) == 317  # the count quoted in the module docstring
+    assert len(BAD_CASES) == 330  # the count quoted in the module docstring
 
 
 @pytest.mark.parametrize("words,option,value", BAD_CASES, ids=[f"{' '.join(w)} {o} {v!r}" for w, o, v in BAD_CASES])

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 
 @dataclasses.dataclass
@@ -127,7 +128,47 @@ class D4PGConfig:
             raise ValueError(f"prior_weight must be >= 0, got {self.prior_weight}")
         if self.n_step < 1 or not 0 < self.discount <= 1:
             raise ValueError("n_step must be >= 1 and discount in (0, 1]")
+        if not 0.0 <= self.sigma <= 2.0:
+            raise ValueError(f"sigma must be in [0, 2] (action units), got {self.sigma}")
+        if not 1 <= self.batch_size <= 65_536:
+            raise ValueError(f"batch_size must be from 1 to 65536, got {self.batch_size}")
+        for name in ("actor_lr", "critic_lr"):
+            if not 0.0 < getattr(self, name) < 1.0:
+                raise ValueError(f"{name} must be in (0, 1), got {getattr(self, name)}")
+        if self.actor_warmup_updates < 0:
+            raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
+
+    # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
+    # defaults table that have no option of their own, so that each can be ablated from the command line
+    SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
+                "actor_warmup_updates", "batch_size", "actor_lr", "critic_lr", "n_step", "discount")
+
+    @classmethod
+    def parse_setting(cls, text: str) -> tuple[str, object]:
+        """``"sigma=0.3"`` -> ``("sigma", 0.3)``: a field of ``SETTABLE`` and a value of its type that
+        passes ``validate`` on its own; ValueError naming the problem otherwise."""
+        name, sep, raw = text.partition("=")
+        name, raw = name.strip(), raw.strip()
+        if not sep or not name or not raw:
+            raise ValueError(f"expected NAME=VALUE, got {text!r}")
+        if name not in cls.SETTABLE:
+            raise ValueError(f"{name!r} cannot be set; one of {', '.join(cls.SETTABLE)}")
+        kind = type(getattr(cls(), name))
+        if kind is bool:
+            words = {"true": True, "on": True, "1": True, "false": False, "off": False, "0": False}
+            if raw.lower() not in words:
+                raise ValueError(f"{name} takes true or false, got {raw!r}")
+            value = words[raw.lower()]
+        else:
+            try:
+                value = kind(raw)
+            except ValueError:
+                raise ValueError(f"{name} takes {'an integer' if kind is int else 'a number'}, got {raw!r}") from None
+            if kind is float and not math.isfinite(value):
+                raise ValueError(f"{name} takes a finite number, got {raw!r}")
+        cls(**{name: value}).validate()
+        return name, value
 
     @classmethod
     def paper(cls, **overrides) -> "D4PGConfig":

@@ -85,6 +85,17 @@ def cmd_evaluate(args) -> int:
     return 0
 
 
+def training_setting(text: str) -> tuple:
+    """``NAME=VALUE`` for ``lbgp train --set`` (an argparse type): a settable training-config field
+    and a valid value (D4PGConfig.parse_setting); lives here, not in cli_args, which is below the agent."""
+    from lbgp.agent.config import D4PGConfig
+
+    try:
+        return D4PGConfig.parse_setting(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def cmd_train(args) -> int:
     from lbgp.agent.config import D4PGConfig
     from lbgp.agent.train import train
@@ -382,7 +393,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--policy-average", type=A.fraction, default=None, metavar="TAU",
                    help="the policy file holds a moving average of the actor's weights, moved TAU toward it per update "
                         "(e.g. 1e-4; default 0: the last actor); the last actor is kept as policy_last.pt")
-    p.add_argument("--set", type=A.training_setting, action="append", metavar="NAME=VALUE",
+    p.add_argument("--set", type=training_setting, action="append", metavar="NAME=VALUE",
                    help="change one training-config field that has no option of its own, over the preset "
                         "(repeatable; e.g. spawn_front_share=0.5, noise_correlation=0, sigma=0.3; "
                         "the fields: D4PGConfig.SETTABLE, docs/training.md)")

@@ -63,16 +63,6 @@ def fraction(text: str) -> float:
     return value
 
 
-def training_setting(text: str) -> tuple[str, object]:
-    """``NAME=VALUE`` for ``lbgp train --set``: a settable training-config field and a valid value."""
-    from lbgp.agent.config import D4PGConfig
-
-    try:
-        return D4PGConfig.parse_setting(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
 def distance(text: str) -> float:
     return _bounded_float(text, 0.0, 10.0, False, "a distance above 0 and at most 10 m")
 

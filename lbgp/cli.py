@@ -96,17 +96,18 @@ def training_setting(text: str) -> tuple:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+# `lbgp train` options that also apply to --resume; every other option describes a new run and
+# --resume refuses it (the parser hands cmd_train that list as args.new_run_options: dest -> option)
+TRAIN_RESUME_OPTIONS = ("help", "steps", "minutes", "backend", "resume")
+
+
 def cmd_train(args) -> int:
     from lbgp.agent.config import D4PGConfig
     from lbgp.agent.train import train
 
     if args.resume:
-        changed = [option for option, value in (("--set", args.set), ("--paper", args.paper), ("--actors", args.actors),
-                                                ("--prior-weight", args.prior_weight), ("--turn-lead", args.turn_lead),
-                                                ("--updates-per-step", args.updates_per_step), ("--randomize", args.randomize),
-                                                ("--mirror-augment", args.mirror_augment), ("--motion-features", args.motion_features),
-                                                ("--previous-goal", args.previous_goal), ("--policy-average", args.policy_average),
-                                                ("--no-curriculum", args.no_curriculum)) if value not in (None, False)]
+        changed = [option for dest, option in args.new_run_options.items()
+                   if getattr(args, dest) is not None and getattr(args, dest) is not False]  # --seed 0 counts
         if changed:
             raise ValueError(f"--resume continues the run with its own config ({args.resume}/config.json); "
                              f"{', '.join(changed)} would be ignored: drop it or start a new run with --out")
@@ -117,7 +118,7 @@ def cmd_train(args) -> int:
             raise ValueError("--out DIR is required (or --resume DIR)")
         preset = D4PGConfig.paper if args.paper else D4PGConfig
         chosen = dict(
-            method=args.method, robot=args.robot, curriculum=not args.no_curriculum, seed=args.seed,
+            method=args.method or "lbgp", robot=args.robot or "jackal", curriculum=not args.no_curriculum, seed=args.seed or 0,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
         )
         given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
@@ -369,12 +370,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_evaluate)
 
     p = sub.add_parser("train", help="train a D4PG policy (LBGP goals or E2E velocities), with curriculum")
-    p.add_argument("--method", default="lbgp", choices=["lbgp", "e2e"])
-    p.add_argument("--robot", default="jackal", choices=["jackal", "turtlebot2"])
+    # the options that say what a new run is default to None (or False): `--resume`, which continues with
+    # the run's own config.json, refuses any of them that was given (TRAIN_RESUME_OPTIONS)
+    p.add_argument("--method", default=None, choices=["lbgp", "e2e"], help="lbgp (default) or e2e")
+    p.add_argument("--robot", default=None, choices=["jackal", "turtlebot2"], help="jackal (default) or turtlebot2")
     p.add_argument("--no-curriculum", action="store_true", help="train on the final level from the start")
     p.add_argument("--steps", type=A.positive_int, default=None, help="environment steps in all (default 300000)")
     p.add_argument("--minutes", type=A.positive_float, default=None, help="also stop after this much wall time")
-    p.add_argument("--seed", type=A.seed, default=0)
+    p.add_argument("--seed", type=A.seed, default=None, help="default 0")
     p.add_argument("--actors", type=A.positive_int, default=None, help="actor processes, one of them exploits (default 2: one per core beside the learner's on 2 cores)")
     p.add_argument("--prior-weight", type=A.nonnegative_float, default=None,
                    help="LBGP: pull the goals toward 1.5 m ahead with this weight in the actor loss (default 1; --paper: 0)")
@@ -403,7 +406,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="processes: actor processes (default); inline: one process, reproducible; ray: Ray tasks (extra)")
     p.add_argument("--out", type=A.output_dir, help="run directory (created)")
     p.add_argument("--resume", type=A.existing_dir, metavar="DIR", help="continue the run in DIR from its last checkpoint")
-    p.set_defaults(func=cmd_train)
+    p.set_defaults(func=cmd_train, new_run_options={a.dest: a.option_strings[0] for a in p._actions
+                                                    if a.option_strings and a.dest not in TRAIN_RESUME_OPTIONS})
 
     p = sub.add_parser("experiment", help="the paper's experiments: sim table, real-world protocol in sim, ablation")
     exp = p.add_subparsers(dest="which", metavar="EXPERIMENT", required=True)

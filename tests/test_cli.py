@@ -158,7 +158,8 @@ def test_train_resume_refuses_options_it_would_ignore(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
     before = {p.name: p.stat().st_mtime_ns for p in run.iterdir()}
-    for extra in (["--set", "sigma=0.3"], ["--paper"], ["--policy-average", "1e-4"]):
+    for extra in (["--set", "sigma=0.3"], ["--paper"], ["--policy-average", "1e-4"], ["--method", "e2e"],
+                  ["--robot", "jackal"], ["--seed", "0"], ["--out", str(tmp_path / "other")]):
         assert main(["train", "--resume", str(run), "--steps", "80", *extra]) == 2
         err = capsys.readouterr().err
         assert extra[0] in err and "config.json" in err

@@ -118,10 +118,11 @@ def cmd_train(args) -> int:
             raise ValueError("--out DIR is required (or --resume DIR)")
         preset = D4PGConfig.paper if args.paper else D4PGConfig
         chosen = dict(
-            method=args.method or "lbgp", robot=args.robot or "jackal", curriculum=not args.no_curriculum, seed=args.seed or 0,
+            curriculum=not args.no_curriculum,
             total_steps=args.steps or D4PGConfig.total_steps, time_limit_s=(args.minutes or 0) * 60.0,
         )
-        given = {"num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
+        given = {"method": args.method, "robot": args.robot, "seed": args.seed,  # None: the config's default
+                 "num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
                  "mirror_augment": True if args.mirror_augment else None, "motion_features": True if args.motion_features else None,
                  "previous_goal": True if args.previous_goal else None, "policy_average": args.policy_average}
         if args.randomize:

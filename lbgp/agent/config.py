@@ -34,7 +34,8 @@ class D4PGConfig:
     # the paper). Correlated noise holds a deviation for ~1 s, long enough for the planner to act on it;
     # white noise of 0.2 s per value mostly averages out in the robot's motion. Stationary std = sigma.
     # Over 3 seeds, white noise with sigma 0.3 scored 10.5 +- 8.6 lower (separated); sigma 0.3 with this
-    # correlation 4.2 +- 3.8 lower (separated); white noise of sigma 0.15 4.8 +- 9.7 lower (not separated).
+    # correlation 4.2 +- 3.8 lower (separated); white noise of sigma 0.15 4.8 +- 9.7 lower (not separated);
+    # sigma 0.1 3.2 +- 3.7 lower and correlation 0.9 0.9 +- 4.7 lower (neither separated).
     weight_sync_steps: int = 200  # actors fetch fresh weights at least this often (agent steps)
     earlier_level_share: float = 0.2  # share of exploring episodes on an earlier curriculum level
     actor_niceness: int = 10  # actors run at lower priority: the learner keeps ~1 core on a 2-core box

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from lbgp.geometry import integrate_unicycle
-from lbgp.sim.paths import evaluation_path
-from lbgp.sim.person import CircleMotion, PathMotion, SmoothedMotion, StraightMotion
+from lbgp.sim.paths import draw_path, evaluation_path, path_length, resample_path
+from lbgp.sim.person import CircleMotion, DrawnPathMotion, PathMotion, SmoothedMotion, StraightMotion
 
 
 def test_straight_speed_is_constant_per_episode_and_in_range():
@@ -73,3 +73,39 @@ def test_anchored_path_starts_at_the_spawn_pose():
     np.testing.assert_allclose(m.path[0], start[:2])
     d = m.path[3] - m.path[0]
     assert math.atan2(d[1], d[0]) == pytest.approx(1.0, abs=1e-6)
+
+
+def test_drawn_path_motion_walks_a_fresh_path_each_episode_and_the_seed_repeats_them():
+    def layouts(seed, episodes=4):
+        m, rng = DrawnPathMotion(5.0), np.random.default_rng(seed)
+        out = []
+        for _ in range(episodes):
+            start = np.array([1.0, 2.0, 0.5])
+            np.testing.assert_allclose(m.reset(rng, start), start)
+            np.testing.assert_allclose(m.path[0], start[:2])  # anchored at the spawn pose, as PathMotion
+            out.append(m.path.copy())
+        return out
+
+    first, again, other = layouts(0), layouts(0), layouts(1)
+    for a, b in zip(first, again):
+        np.testing.assert_array_equal(a, b)
+    shapes = [np.round(p - p[0], 6).tobytes() for p in first + other]
+    assert len(set(shapes)) == len(shapes)  # no layout twice: not a library
+    for p in first:  # each is a drawn path of the library's length (start share 0: whole)
+        assert path_length(p) == pytest.approx(path_length(resample_path(draw_path(7, 5.0))), abs=0.1)
+
+
+def test_drawn_paths_replace_only_the_trajectories_levels_library():
+    from lbgp.agent.actors import EnvCache
+    from lbgp.agent.config import D4PGConfig
+    from lbgp.sim import make_env
+
+    assert type(make_env("trajectories", seed=0, drawn_paths=True).task.motion) is DrawnPathMotion
+    assert type(make_env("trajectories", seed=0).task.motion) is PathMotion
+    with pytest.raises(ValueError, match="trajectories"):
+        make_env("circles", drawn_paths=True)
+    envs = EnvCache(D4PGConfig(drawn_paths=True), np.random.default_rng(0))
+    assert type(envs("trajectories").task.motion) is DrawnPathMotion
+    assert type(envs("circles").task.motion) is CircleMotion
+    assert type(EnvCache(D4PGConfig(), np.random.default_rng(0))("trajectories").task.motion) is PathMotion
+    assert D4PGConfig.parse_setting("drawn_paths=on") == ("drawn_paths", True)

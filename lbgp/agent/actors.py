@@ -21,7 +21,7 @@ from lbgp.agent.learner import make_actor
 from lbgp.agent.networks import Actor
 from lbgp.agent.nstep import NStepAccumulator
 from lbgp.agent.previous_goal import agent_input, agent_input_size, first_previous_action
-from lbgp.sim.tasks import CURRICULUM
+from lbgp.sim.tasks import CURRICULUM, DRAWN_PATHS_LEVEL
 
 ACTION_SIZE = 2
 
@@ -139,7 +139,8 @@ class EnvCache:
             cfg = self.cfg
             self.envs[level] = make_env(level, robot=cfg.robot, seed=int(self.rng.integers(2**31)), control=cfg.control,
                                         horizon=cfg.horizon, spawn_front_share=cfg.spawn_front_share,
-                                        randomize=cfg.randomize or None)
+                                        randomize=cfg.randomize or None,
+                                        drawn_paths=cfg.drawn_paths and level == DRAWN_PATHS_LEVEL)
         return self.envs[level]
 
 

@@ -91,6 +91,8 @@ class D4PGConfig:
     # line in the replay (observation and next observation mirrored, the action's lateral part negated,
     # same return): the task is symmetric, so each episode teaches both turn directions. Off: over 3
     # seeds it did not beat mirror-averaged acting alone (166.1 vs 168.2 on the paper scenarios; docs/training.md)
+    drawn_paths: bool = False  # the trajectories level draws a fresh person path every episode
+    # (lbgp.sim.tasks.drawn_paths_setting) instead of walking one of the library's 20
     spawn_front_share: float = 0.75  # share of training spawns in front of the person (|alpha| < 90 deg);
     # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn. Over 3 seeds uniform
     # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/training.md)
@@ -148,7 +150,7 @@ class D4PGConfig:
     # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
-                "actor_warmup_updates", "batch_size", "actor_lr", "critic_lr", "n_step", "discount")
+                "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

@@ -131,6 +131,7 @@ def make_env(
     randomize=None,
     calibration=None,
     drive_model=None,
+    drawn_paths: bool = False,
 ) -> FollowAheadEnv:
     """A follow-ahead environment.
 
@@ -155,8 +156,12 @@ def make_env(
         wheels: ``None`` (the identity), a ``CommandCalibration`` or a JSON file (``lbgp sysid``'s output).
       drive_model: the planner's model of the robot's drive (``lbgp.drive_model``): ``None`` (the
         ideal drive it assumes by default), a ``Dynamics``, a named set or ``lbgp sysid``'s JSON.
+      drawn_paths: the trajectories level only (training): the person walks a freshly drawn path
+        every episode (``lbgp.sim.tasks.drawn_paths_setting``) instead of one of the library's 20.
     """
     setting = tasks.get_setting(level)
+    if drawn_paths:
+        setting = tasks.drawn_paths_setting(setting)
     if person_path is not None:
         spawn = setting.spawn if setting.spawn is not None else (DESIRED_DISTANCE, 0.0)
         setting = tasks.path_setting(person_path, spawn=spawn)

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from lbgp.geometry import wrap_angle
-from lbgp.sim.paths import resample_path
+from lbgp.sim.paths import draw_path, resample_path
 
 
 class PersonMotion:
@@ -166,3 +166,23 @@ class PathMotion(PersonMotion):
         # slow down for sharp heading errors, like a person turning on the spot
         v = self.speed * max(0.2, math.cos(min(abs(error), math.pi / 2)))
         return v, w
+
+
+class DrawnPathMotion(PathMotion):
+    """PathMotion on a freshly drawn human-like path every episode instead of the library's 20.
+
+    Each episode draws a path of ``length`` metres with :func:`lbgp.sim.paths.draw_path` (the
+    generator of the library and of the evaluation paths), seeded from the episode's random stream,
+    and walks it as :class:`PathMotion` walks the library's: the same straights, arcs and speeds,
+    never the same layout twice. For training only (``lbgp train --set drawn_paths=true``).
+    """
+
+    def __init__(self, length: float, **kwargs):
+        if not (math.isfinite(length) and length > 0.0):
+            raise ValueError(f"a drawn path needs a finite length > 0 m, got {length!r}")
+        self.length = float(length)
+        super().__init__(draw_path(0, self.length), speed=None, **kwargs)
+
+    def reset(self, rng, pose):
+        self.paths = [resample_path(draw_path(int(rng.integers(2**31)), self.length))]
+        return super().reset(rng, pose)

@@ -29,7 +29,7 @@ from lbgp.sim import observation as obs_lib
 from lbgp.drive_train import DriveTrain
 from lbgp.sim.drive import ModelDynamics
 from lbgp.sim import paths as path_lib
-from lbgp.sim.person import CircleMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
+from lbgp.sim.person import CircleMotion, DrawnPathMotion, PathMotion, PersonMotion, SmoothedMotion, StraightMotion
 from lbgp.sim.rewards import follow_ahead_reward, out_of_range
 from lbgp.robots import DiffDrive, RobotSpec
 from lbgp.sim.robots import actuator_indices
@@ -244,6 +244,17 @@ def get_setting(name: str) -> Setting:
         raise ValueError(
             f"unknown level or scenario {name!r}; levels: {', '.join(LEVELS)}; scenarios: {', '.join(SCENARIOS)}"
         ) from None
+
+
+DRAWN_PATHS_LEVEL = "trajectories"
+
+
+def drawn_paths_setting(setting: Setting) -> Setting:
+    """The trajectories level with a freshly drawn path every episode (``DrawnPathMotion``: same
+    length, start share and speeds as the library's) instead of one of the library's 20."""
+    if setting.name != DRAWN_PATHS_LEVEL:
+        raise ValueError(f"drawn paths replace the {DRAWN_PATHS_LEVEL} level's library; {setting.name!r} walks no library")
+    return dataclasses.replace(setting, motion=lambda: DrawnPathMotion(path_lib.TRAIN_LENGTH, start_fraction=0.3))
 
 
 def path_setting(path, spawn=(DESIRED_DISTANCE, 0.0), speed: float = 0.5) -> Setting:

@@ -93,6 +93,7 @@ class D4PGConfig:
     # seeds it did not beat mirror-averaged acting alone (166.1 vs 168.2 on the paper scenarios; docs/training.md)
     drawn_paths: bool = False  # the trajectories level draws a fresh person path every episode
     # (lbgp.sim.tasks.drawn_paths_setting) instead of walking one of the library's 20
+    # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/training.md)
     spawn_front_share: float = 0.75  # share of training spawns in front of the person (|alpha| < 90 deg);
     # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn. Over 3 seeds uniform
     # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/training.md)

@@ -41,7 +41,7 @@ class D4PGConfig:
     actor_niceness: int = 10  # actors run at lower priority: the learner keeps ~1 core on a 2-core box
 
     # --- learner
-    n_step: int = 5  # (acme)
+    n_step: int = 5  # (acme); 10 over 3 seeds: 1.2 +- 4.8 lower on the paper scenarios (not separated)
     discount: float = 0.97  # acme 0.99; 0.97 (effective horizon ~33 steps) matches 35-step episodes
     batch_size: int = 256  # (acme)
     actor_lr: float = 3e-4  # acme 1e-4; 3e-4 learns faster within the ~100k updates a 2-core budget allows

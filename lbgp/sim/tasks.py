@@ -195,8 +195,11 @@ class Setting:
     random_person_heading: bool = True
 
 
+LIBRARY_START_FRACTION = 0.3  # a trajectories-level episode starts in the first 30 % of its path
+
+
 def _library_motion() -> PersonMotion:
-    return PathMotion(path_lib.training_library(), speed=None, start_fraction=0.3)
+    return PathMotion(path_lib.training_library(), speed=None, start_fraction=LIBRARY_START_FRACTION)
 
 
 def _eval_path_motion(name: str) -> Callable[[], PersonMotion]:
@@ -254,7 +257,8 @@ def drawn_paths_setting(setting: Setting) -> Setting:
     length, start share and speeds as the library's) instead of one of the library's 20."""
     if setting.name != DRAWN_PATHS_LEVEL:
         raise ValueError(f"drawn paths replace the {DRAWN_PATHS_LEVEL} level's library; {setting.name!r} walks no library")
-    return dataclasses.replace(setting, motion=lambda: DrawnPathMotion(path_lib.TRAIN_LENGTH, start_fraction=0.3))
+    return dataclasses.replace(setting, motion=lambda: DrawnPathMotion(path_lib.TRAIN_LENGTH,
+                                                                    start_fraction=LIBRARY_START_FRACTION))
 
 
 def path_setting(path, spawn=(DESIRED_DISTANCE, 0.0), speed: float = 0.5) -> Setting:

@@ -88,14 +88,19 @@ def acting_run_name(run: str, deadband: float | None = None, mirror: bool = MIRR
     return f"{variant_of(run)}{tags}_s{seed_of(run)}" if tags else run
 
 
+def scenario_seed(seed: int, name: str) -> int:
+    """The ``evaluate`` seed of scenario ``name``'s episodes, as ``lbgp experiment sim`` seeds the
+    full table: every policy scored with it faces the sim table's episodes."""
+    return seed + 1000 * scenario_names().index(name)
+
+
 def score(job: tuple) -> tuple[str, dict]:
     """job: (name, method, policy_file, scenarios, episodes, seed, deadband, mirror[, planner_changes]);
     ``planner_changes``: PlannerConfig fields to change from the Jackal's preset (default none)."""
     name, method, policy_file, scenarios, episodes, seed, deadband, mirror, *rest = job
     planner = planner_config_for("jackal").with_(**rest[0]) if rest and rest[0] else None
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
-    # scenario k's episodes seeded as lbgp experiment sim seeds them: its rows are the same episodes
-    rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=seed + 1000 * scenario_names().index(name),
+    rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=scenario_seed(seed, name),
                      obs_noise=True, planner_config=planner)[0] for name in scenarios]
     per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),

@@ -24,6 +24,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
+from ablation_scenarios import scenario_seed  # noqa: E402
 
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
@@ -65,7 +66,7 @@ def score(job: tuple) -> tuple[tuple, float]:
     """job: (policy files, scenario, episodes, seed) -> (files, scenario), mean reward."""
     files, name, episodes, seed = job
     row = evaluate(EnsemblePolicy(files), "lbgp", [name], robot="jackal", episodes=episodes,
-                   seed=seed + 1000 * scenario_names().index(name), obs_noise=True)[0]
+                   seed=scenario_seed(seed, name), obs_noise=True)[0]
     return (files, name), round(float(row["reward"]), 3)
 
 

@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 from lbgp.agent.config import D4PGConfig
+from lbgp.agent.critic_future import hindsight_features
 from lbgp.agent.learner import make_actor
 from lbgp.agent.networks import Actor
 from lbgp.agent.nstep import NStepAccumulator
@@ -95,12 +96,14 @@ class ExplorationNoise:
 def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.random.Generator, nstep: NStepAccumulator, refresh=None):
     """One episode; returns (n-step transition batch, return, steps). ``refresh()`` is called every
     ``weight_sync_steps`` steps so that long episodes pick up new weights. With
-    ``cfg.previous_goal`` the transitions hold agent inputs (observation + the action sent before)."""
-    transitions, episode_return, steps = [], 0.0, 0
-    nstep.reset()
+    ``cfg.previous_goal`` the transitions hold agent inputs (observation + the action sent before);
+    with ``cfg.critic_future`` the critic's hindsight features follow them (``lbgp.agent.critic_future``),
+    which is why the n-step transitions are formed once the episode is over."""
+    steps_taken, episode_return, steps = [], 0.0, 0
     timestep = env.reset()
     noise = ExplorationNoise(cfg.sigma, cfg.noise_correlation, rng)
     sent = first_previous_action(actor)
+    poses = [_true_poses(env)] if cfg.critic_future else None
 
     def inputs(observation):
         return agent_input(observation, sent) if cfg.previous_goal else observation
@@ -115,15 +118,30 @@ def play_episode(env, actor: Actor, exploring: bool, cfg: D4PGConfig, rng: np.ra
         sent = np.asarray(action, np.float32)
         episode_return += timestep.reward
         steps += 1
+        if poses is not None:
+            poses.append(_true_poses(env))
         terminal = timestep.last() and timestep.discount == 0.0
         truncated = timestep.last() and not terminal
         next_obs = inputs(timestep.observation)
-        transitions += nstep.step(obs, action, timestep.reward, next_obs, terminal, truncated)
+        steps_taken.append((obs, action, timestep.reward, next_obs, terminal, truncated))
         obs = next_obs
         if refresh is not None and steps % cfg.weight_sync_steps == 0:
             refresh()
+    if poses is not None:
+        robots, persons = (np.array(p) for p in zip(*poses))
+        future = hindsight_features(robots, persons)
+        steps_taken = [(np.concatenate([o, future[t]]), a, r, np.concatenate([n, future[t + 1]]), term, trunc)
+                       for t, (o, a, r, n, term, trunc) in enumerate(steps_taken)]
+    nstep.reset()
+    transitions = [tr for step in steps_taken for tr in nstep.step(*step)]
     batch = tuple(np.array([t[i] for t in transitions], np.float32) for i in range(5))
     return batch, float(episode_return), steps
+
+
+def _true_poses(env) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's and the person's true world poses now (for the critic's hindsight only)."""
+    info = env.info()
+    return info["robot_pose"], info["person_pose"]
 
 
 class EnvCache:

@@ -94,6 +94,9 @@ class D4PGConfig:
     drawn_paths: bool = False  # the trajectories level draws a fresh person path every episode
     # (lbgp.sim.tasks.drawn_paths_setting) instead of walking one of the library's 20
     # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/training.md)
+    critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
+    # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
+    # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
     spawn_front_share: float = 0.75  # share of training spawns in front of the person (|alpha| < 90 deg);
     # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn. Over 3 seeds uniform
     # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/training.md)
@@ -144,6 +147,8 @@ class D4PGConfig:
         for name in ("actor_lr", "critic_lr"):
             if not 0.0 < getattr(self, name) < 1.0:
                 raise ValueError(f"{name} must be in (0, 1), got {getattr(self, name)}")
+        if self.critic_future and self.mirror_augment:
+            raise ValueError("critic_future and mirror_augment cannot be combined (the hindsight features are not mirrored)")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -151,7 +156,8 @@ class D4PGConfig:
     # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
-                "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount")
+                "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
+                "critic_future")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

@@ -9,6 +9,7 @@ import torch.nn.functional as F
 
 from lbgp.actions import DESIRED_GOAL, action_from_goal
 from lbgp.agent.config import D4PGConfig
+from lbgp.agent.critic_future import SIZE as CRITIC_FUTURE_SIZE
 from lbgp.agent.distributional import categorical_projection
 from lbgp.agent.networks import Actor, DistributionalCritic
 
@@ -29,9 +30,13 @@ def polyak_(average: torch.nn.Module, net: torch.nn.Module, tau: float) -> None:
 
 class D4PGLearner:
     def __init__(self, cfg: D4PGConfig, obs_size: int, action_size: int):
+        """``obs_size``: the agent input's (the actor's); with ``cfg.critic_future`` the replay's and
+        the critic's inputs hold the hindsight features after it (``lbgp.agent.critic_future``)."""
         self.cfg = cfg
+        self.actor_inputs = int(obs_size)  # the actor reads the first obs_size numbers of a stored input
         self.actor = make_actor(cfg, obs_size, action_size)
-        self.critic = DistributionalCritic(obs_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden,
+        critic_size = obs_size + (CRITIC_FUTURE_SIZE if cfg.critic_future else 0)
+        self.critic = DistributionalCritic(critic_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden,
                                            motion_features=cfg.motion_features)
         self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
         self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)
@@ -51,18 +56,21 @@ class D4PGLearner:
         (called once, on the first replay contents, before the first update); with motion features
         the statistics are those of the networks' inputs, the features included."""
         with torch.no_grad():
-            inputs = self.actor.inputs(torch.as_tensor(observations, dtype=torch.float32))
-        mean, std = inputs.mean(0), inputs.std(0)
-        for net in (self.actor, self.target_actor, self.critic, self.target_critic, self.average_actor):
+            stored = torch.as_tensor(observations, dtype=torch.float32)
+            actor_in = self.actor.inputs(stored[:, : self.actor_inputs])
+            critic_in = self.critic.inputs(stored)
+        for net in (self.actor, self.target_actor, self.average_actor):
             if net is not None:
-                net.set_obs_stats(mean, std)
+                net.set_obs_stats(actor_in.mean(0), actor_in.std(0))
+        for net in (self.critic, self.target_critic):
+            net.set_obs_stats(critic_in.mean(0), critic_in.std(0))
         self.obs_stats_set = True
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         obs, action = batch["obs"], batch["action"]
         # critic: cross-entropy to the projected n-step target distribution
         with torch.no_grad():
-            next_action = self.target_actor(batch["next_obs"])
+            next_action = self.target_actor(batch["next_obs"][:, : self.actor_inputs])
             next_probs = torch.softmax(self.target_critic(batch["next_obs"], next_action), dim=-1)
             target = categorical_projection(next_probs, batch["ret"], batch["discount"], self.critic.atoms)
         logits = self.critic(obs, action)
@@ -91,12 +99,14 @@ class D4PGLearner:
         return {"critic_loss": float(critic_loss.detach()), "actor_loss": float(actor_loss.detach()), "q": float(q.detach().mean())}
 
     def actor_loss(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """Deterministic policy gradient through the critic's expected value, plus (LBGP) the goal prior."""
-        action = self.actor(obs)
+        """Deterministic policy gradient through the critic's expected value, plus (LBGP) the goal
+        prior; ``obs``: stored inputs (the actor reads their first ``actor_inputs`` numbers)."""
+        actor_obs = obs[:, : self.actor_inputs]
+        action = self.actor(actor_obs)
         q = self.critic.q_value(obs, action)
         loss = -q.mean()
         if self.prior_weight > 0:
-            prior = self.actor.base_action(obs) if self.actor.residual_scale > 0 else self.prior
+            prior = self.actor.base_action(actor_obs) if self.actor.residual_scale > 0 else self.prior
             loss = loss + self.prior_weight * ((action - prior) ** 2).sum(-1).mean()
         return loss, q
 

@@ -37,6 +37,7 @@ from lbgp.agent.config import D4PGConfig
 from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
+from lbgp.agent.critic_future import critic_input_size
 from lbgp.agent.previous_goal import agent_input_size
 from lbgp.agent.replay import ReplayBuffer, mirrored
 
@@ -110,9 +111,8 @@ class Trainer:
         torch.set_num_threads(cfg.torch_threads)
         torch.manual_seed(cfg.seed)
         self.rng = np.random.default_rng(cfg.seed)
-        inputs = agent_input_size(cfg.previous_goal)
-        self.learner = D4PGLearner(cfg, inputs, 2)
-        self.replay = ReplayBuffer(cfg.replay_capacity, inputs, 2)
+        self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
+        self.replay = ReplayBuffer(cfg.replay_capacity, critic_input_size(cfg.previous_goal, cfg.critic_future), 2)
         self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps,
                                      cfg.curriculum_window, cfg.time_limit_s)
         self.env_steps = 0

@@ -34,10 +34,10 @@ from lbgp.agent.actors import InlineActors, ProcessActors, flat_parameters
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.files import atomic_file, write_json
 from lbgp.agent.config import D4PGConfig
+from lbgp.agent.critic_future import critic_input_size
 from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
-from lbgp.agent.critic_future import critic_input_size
 from lbgp.agent.previous_goal import agent_input_size
 from lbgp.agent.replay import ReplayBuffer, mirrored
 

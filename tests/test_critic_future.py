@@ -10,16 +10,16 @@ import torch
 
 from lbgp.agent.actors import play_episode
 from lbgp.agent.config import D4PGConfig
-from lbgp.agent.critic_future import SIZE, STEPS, continue_path, critic_input_size, hindsight_features
+from lbgp.agent.critic_future import SIZE, STEPS, continue_path, hindsight_features
 from lbgp.agent.learner import D4PGLearner, make_actor
 from lbgp.agent.nstep import NStepAccumulator
 from lbgp.agent.policy import load_policy
 from lbgp.agent.train import Trainer
-from lbgp.geometry import integrate_unicycle
+from lbgp.geometry import from_frame, integrate_unicycle
 from lbgp.sim import make_env
 from lbgp.sim import observation as obs_lib
 
-WIDE = critic_input_size(False, True)
+WIDE = obs_lib.SIZE + SIZE  # the observation, then the hindsight features
 
 
 def _circle(v: float, w: float, n: int, start=(1.0, -2.0, 0.3)) -> np.ndarray:
@@ -29,8 +29,6 @@ def _circle(v: float, w: float, n: int, start=(1.0, -2.0, 0.3)) -> np.ndarray:
 def test_features_are_the_true_relative_robot_pose_and_the_persons_next_second():
     persons = _circle(0.5, 0.4, 8)
     ahead = np.array([[1.5, 0.2, 0.1]])
-    from lbgp.geometry import from_frame
-
     robots = np.concatenate([from_frame(ahead, p) for p in persons])
     feats = hindsight_features(robots, persons)
     assert feats.shape == (8, SIZE) and feats.dtype == np.float32
@@ -81,7 +79,7 @@ def test_actors_append_the_features_after_the_episode_and_act_on_the_observation
 def test_the_learners_actor_reads_the_agent_input_and_the_critic_the_features():
     cfg = D4PGConfig(hidden=(8,), batch_size=16, actor_warmup_updates=0, critic_future=True)
     learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
-    assert learner.critic.norm.obs_std.shape == (WIDE,) and learner.actor.norm.obs_std.shape == (obs_lib.SIZE,)
+    assert learner.critic_inputs == WIDE and learner.critic.norm.obs_std.shape == (WIDE,) and learner.actor.norm.obs_std.shape == (obs_lib.SIZE,)
     rng = np.random.default_rng(0)
     stored = rng.uniform(-1, 1, (64, WIDE)).astype(np.float32)
     stored[:, obs_lib.SIZE:] *= 0.1

@@ -15,7 +15,7 @@ scaled as the observation is (``lbgp.sim.observation.scale``). Where an episode 
 the person's last step is continued at its last twist (a truncated episode's final value is
 bootstrapped; a terminated one's is not used).
 
-The features follow the agent input in the replay and in the critic's input (``critic_input_size``);
+The features follow the agent input in the replay and in the critic's input (the learner's ``critic_inputs``);
 the actor reads only the agent input before them, so the policy file, the deploy loop and the
 observation are unchanged. Its gradient is that of the hindsight value, whose mean over the futures
 the observation allows is the policy's own value.
@@ -25,17 +25,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from lbgp.agent.previous_goal import agent_input_size
 from lbgp.geometry import from_frame, to_frame
 from lbgp.sim import observation as obs_lib
 
 STEPS = 5  # 1 s of the person's future at the agent's 5 Hz
 SIZE = 3 * (STEPS + 1)
-
-
-def critic_input_size(previous_goal: bool, critic_future: bool) -> int:
-    """What the critic (and the replay) holds per step: the agent input, plus the hindsight features if asked."""
-    return agent_input_size(previous_goal) + (SIZE if critic_future else 0)
 
 
 def continue_path(person_poses: np.ndarray, steps: int) -> np.ndarray:

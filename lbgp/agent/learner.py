@@ -35,8 +35,9 @@ class D4PGLearner:
         self.cfg = cfg
         self.actor_inputs = int(obs_size)  # the actor reads the first obs_size numbers of a stored input
         self.actor = make_actor(cfg, obs_size, action_size)
-        critic_size = obs_size + (CRITIC_FUTURE_SIZE if cfg.critic_future else 0)
-        self.critic = DistributionalCritic(critic_size, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden,
+        # what the critic, and so the replay, holds per step: the agent input, then any hindsight features
+        self.critic_inputs = self.actor_inputs + (CRITIC_FUTURE_SIZE if cfg.critic_future else 0)
+        self.critic = DistributionalCritic(self.critic_inputs, action_size, cfg.num_atoms, cfg.v_min, cfg.v_max, cfg.hidden,
                                            motion_features=cfg.motion_features)
         self.target_actor = copy.deepcopy(self.actor).requires_grad_(False)
         self.target_critic = copy.deepcopy(self.critic).requires_grad_(False)

@@ -34,7 +34,6 @@ from lbgp.agent.actors import InlineActors, ProcessActors, flat_parameters
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.files import atomic_file, write_json
 from lbgp.agent.config import D4PGConfig
-from lbgp.agent.critic_future import critic_input_size
 from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
@@ -112,7 +111,7 @@ class Trainer:
         torch.manual_seed(cfg.seed)
         self.rng = np.random.default_rng(cfg.seed)
         self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
-        self.replay = ReplayBuffer(cfg.replay_capacity, critic_input_size(cfg.previous_goal, cfg.critic_future), 2)
+        self.replay = ReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2)
         self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps,
                                      cfg.curriculum_window, cfg.time_limit_s)
         self.env_steps = 0

@@ -77,6 +77,7 @@ class D4PGConfig:
     residual_scale: float = 0.375  # > 0: the actor outputs the goal 1.5 m ahead plus a residual bounded by
     # this (action units: 0.375 = 0.75 m), its last layer initialised to zero; 0 = the paper's plain actor.
     # E2E: always plain. Over 3 seeds a plain actor trailed by 8.2 +- 16.2 on the paper scenarios (not separated)
+    # and a wider residual (0.5: +-1.0 m) by 1.6 +- 3.6 (not separated): docs/training.md
     turn_lead: float = 0.0  # m per rad/s: the residual's base goal moves this much farther ahead per
     # rad/s of the person's turn rate seen in the observation (a turn-aware base); 0 = the goal 1.5 m ahead
     motion_features: bool = False  # actor and critic also see the person's velocity and turn rate and the

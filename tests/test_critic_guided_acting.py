@@ -17,7 +17,6 @@ from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.learner import D4PGLearner  # noqa: E402
 from lbgp.agent.train import CHECKPOINT_FORMAT  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
-from lbgp.sim import make_env  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 
 SHIPPED = str(default_policy_path("lbgp"))
@@ -42,19 +41,10 @@ class BowlCritic(torch.nn.Module):
         return -((action - best) ** 2).sum(-1)
 
 
-def observations(n=5):
-    env = make_env("turning_inside", seed=1, obs_noise=True)
-    ts, out = env.reset(), []
-    for _ in range(n):
-        out.append(ts.observation)
-        ts = env.step(np.array([0.25, 0.1]))
-    return out
-
-
-def test_the_guided_policy_sends_the_candidate_the_critic_values_most():
+def test_the_guided_policy_sends_the_candidate_the_critic_values_most(noisy_observations):
     plain = make_policy("lbgp", SHIPPED, robot="jackal")
     radius = 0.1
-    for obs in observations():
+    for obs in noisy_observations("turning_inside", 1, 5):
         own = plain.act(obs)
         # the critic's favourite lies up and right of the actor's action, beyond the grid: the corner wins
         guided = CriticGuidedPolicy(plain, BowlCritic(obs, np.clip(own + [0.5, 0.0], -1, 1)), radius)
@@ -65,15 +55,15 @@ def test_the_guided_policy_sends_the_candidate_the_critic_values_most():
         assert guided.act(obs) == pytest.approx(own + [step, -step], abs=1e-5)
 
 
-def test_a_critic_favouring_the_actors_own_action_changes_nothing():
+def test_a_critic_favouring_the_actors_own_action_changes_nothing(noisy_observations):
     plain = make_policy("lbgp", SHIPPED, robot="jackal")
-    for obs in observations():
+    for obs in noisy_observations("turning_inside", 1, 5):
         own = plain.act(obs)
         guided = CriticGuidedPolicy(plain, BowlCritic(obs, own), 0.1)
         assert guided.act(obs) == pytest.approx(own, abs=1e-6)
 
 
-def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path):
+def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path, noisy_observations):
     cfg = D4PGConfig(method="lbgp", robot="jackal")
     learner = D4PGLearner(cfg, obs_lib.SIZE, 2)
     with torch.no_grad():
@@ -82,7 +72,7 @@ def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path):
     save_atomic({"format": CHECKPOINT_FORMAT, "version": 1, "config": cfg.__dict__ | {"hidden": list(cfg.hidden)},
                  "learner": learner.state_dict()}, tmp_path / "checkpoint.pt")
     critic = load_critic(tmp_path)
-    obs = torch.as_tensor(np.stack(observations(3)), dtype=torch.float32)
+    obs = torch.as_tensor(np.stack(noisy_observations("turning_inside", 1, 3)), dtype=torch.float32)
     actions = torch.tensor([[0.2, 0.1], [-0.3, 0.5], [0.0, 0.0]])
     with torch.no_grad():
         torch.testing.assert_close(critic.q_value(obs, actions), learner.critic.q_value(obs, actions))
@@ -94,9 +84,9 @@ def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path):
         load_critic(tmp_path)
 
 
-def test_mirror_images_get_mirrored_choices():
+def test_mirror_images_get_mirrored_choices(noisy_observations):
     plain = make_policy("lbgp", SHIPPED, robot="jackal")
-    for obs in observations():
+    for obs in noisy_observations("turning_inside", 1, 5):
         own = plain.act(obs)
         critic = BowlCritic(obs, own + [0.04, 0.07])
         choice = CriticGuidedPolicy(plain, critic, 0.1).act(obs)

@@ -13,32 +13,22 @@ from policy_ensemble import EnsemblePolicy, main  # noqa: E402
 
 from lbgp.actions import goal_from_action  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
-from lbgp.sim import make_env  # noqa: E402
 
 SHIPPED = str(default_policy_path("lbgp"))
 OTHER = str(Path(__file__).resolve().parents[1] / "results" / "motion_features_runs" / "LBGP_s0" / "policy.pt")
 
 
-def observations(n=6):
-    env = make_env("turning_inside", seed=0, obs_noise=True)
-    ts, out = env.reset(), []
-    for _ in range(n):
-        out.append(ts.observation)
-        ts = env.step(np.array([0.25, 0.1]))
-    return out
-
-
-def test_an_ensemble_of_one_policy_twice_acts_as_that_policy():
+def test_an_ensemble_of_one_policy_twice_acts_as_that_policy(noisy_observations):
     alone, twice = make_policy("lbgp", SHIPPED, robot="jackal"), EnsemblePolicy([SHIPPED, SHIPPED])
-    for obs in observations():
+    for obs in noisy_observations("turning_inside", 0, 6):
         np.testing.assert_allclose(twice.act(obs), alone.act(obs), atol=1e-5)
 
 
-def test_an_ensemble_acts_with_the_mean_of_its_members_goals():
+def test_an_ensemble_acts_with_the_mean_of_its_members_goals(noisy_observations):
     ensemble = EnsemblePolicy([SHIPPED, OTHER], goal_deadband=0.0)
     members = [make_policy("lbgp", f, robot="jackal", goal_deadband=0.0) for f in (SHIPPED, OTHER)]
     apart = 0.0
-    for obs in observations():
+    for obs in noisy_observations("turning_inside", 0, 6):
         goals = [goal_from_action(m.act(obs)) for m in members]
         apart = max(apart, float(np.hypot(*(goals[0] - goals[1]))))
         np.testing.assert_allclose(goal_from_action(ensemble.act(obs)), (goals[0] + goals[1]) / 2, atol=1e-5)

@@ -5,9 +5,10 @@
 
 Runs the real training loop (learner here, actor processes beside it) with the default
 configuration for ``--seconds`` of wall time (after start-up), once per batch size (default: the
-configuration's), then reports the rates measured from each run's summary. With 2 updates per env
-step the actors wait for the learner, so a cheaper update means more env steps too. Run it on an
-otherwise idle machine: it uses every core.
+configuration's), then reports the rates measured from each run's summary. The learner is capped
+at ``max_updates_per_step`` updates per env step and shares the cores with the actors, so a cheaper
+update leaves the actors more CPU: more env steps too. Run it on an otherwise idle machine: it
+uses every core.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
 """benchmarks/critic_guided_acting.py: acting with the critic's best goal near the actor's."""
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -24,6 +25,12 @@ from lbgp.policies import default_policy_path, make_policy  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 
 SHIPPED = str(default_policy_path("lbgp"))
+
+
+def write_checkpoint(path: Path, cfg: D4PGConfig, learner: D4PGLearner) -> None:
+    """The parts of a training checkpoint that load_critic reads, written as training writes them."""
+    save_atomic({"format": CHECKPOINT_FORMAT, "version": 1, "config": dataclasses.asdict(cfg),
+                 "learner": learner.state_dict()}, path)
 
 
 class BowlCritic(torch.nn.Module):
@@ -73,8 +80,7 @@ def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path, noisy_obse
     with torch.no_grad():
         for p in learner.critic.parameters():
             p.add_(0.1 * torch.randn_like(p))
-    save_atomic({"format": CHECKPOINT_FORMAT, "version": 1, "config": cfg.__dict__ | {"hidden": list(cfg.hidden)},
-                 "learner": learner.state_dict()}, tmp_path / "checkpoint.pt")
+    write_checkpoint(tmp_path / "checkpoint.pt", cfg, learner)
     critic = load_critic(tmp_path)
     obs = torch.as_tensor(np.stack(noisy_observations("turning_inside", 1, 3)), dtype=torch.float32)
     actions = torch.tensor([[0.2, 0.1], [-0.3, 0.5], [0.0, 0.0]])
@@ -82,8 +88,7 @@ def test_the_critic_is_read_back_from_a_training_checkpoint(tmp_path, noisy_obse
         torch.testing.assert_close(critic.q_value(obs, actions), learner.critic.q_value(obs, actions))
     # a run whose critic reads hindsight features is refused with its reason
     future = D4PGConfig(method="lbgp", robot="jackal", critic_future=True)
-    save_atomic({"format": CHECKPOINT_FORMAT, "version": 1, "config": future.__dict__ | {"hidden": list(future.hidden)},
-                 "learner": D4PGLearner(future, obs_lib.SIZE, 2).state_dict()}, tmp_path / "checkpoint.pt")
+    write_checkpoint(tmp_path / "checkpoint.pt", future, D4PGLearner(future, obs_lib.SIZE, 2))
     with pytest.raises(ValueError, match="critic_future"):
         load_critic(tmp_path)
 
@@ -108,8 +113,7 @@ def write_untrained_run(folder: Path, seed: int) -> None:
         for p in [*learner.critic.parameters(), *learner.policy_actor.parameters()]:
             p.add_(0.3 * torch.randn_like(p))
     folder.mkdir(parents=True)
-    save_atomic({"format": CHECKPOINT_FORMAT, "version": 1, "config": cfg.__dict__ | {"hidden": list(cfg.hidden)},
-                 "learner": learner.state_dict()}, folder / "checkpoint.pt")
+    write_checkpoint(folder / "checkpoint.pt", cfg, learner)
     save_policy(folder / "policy.pt", learner.policy_actor, "lbgp", "jackal", cfg.hidden,
                 residual_scale=cfg.actor_residual_scale)
 

@@ -39,7 +39,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -207,7 +207,7 @@ def main(argv: list[str] | None = None) -> dict:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")
     result = {
-        "command": "python benchmarks/ablation_scenarios.py " + " ".join(sys.argv[1:] if argv is None else argv),
+        "command": command_line("ablation_scenarios.py", argv),
         "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios,
         "hc": hc, "variants": summarise(scored), "runs": scored,
     }

@@ -22,7 +22,7 @@ from pathlib import Path
 
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.train import train  # noqa: E402
@@ -58,7 +58,7 @@ def main() -> None:
             "learner_updates": summary["learner_updates"],
             "learner_updates_per_s": round(summary["learner_updates"] / summary["wall_time_s"], 1),
         })
-    command = "python benchmarks/bench_train.py " + " ".join(sys.argv[1:])
+    command = command_line("bench_train.py")
     write_result(args.json, {"command": command, "method": args.method, "cpu_count": os.cpu_count(), "runs": runs})
 
 

@@ -26,7 +26,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 from ablation_scenarios import paired_difference, scenario_seed  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> dict:
         # paired by run: keyed x_s<index of the run>, so every run pairs with its own plain policy
         guided = {f"x_s{i}": scored[f"{run.name}@critic{r:g}"]["sum"] for i, run in enumerate(runs)}
         by_radius[f"{r:g}"] = paired_difference(guided, {f"x_s{i}": plain[run.name] for i, run in enumerate(runs)})
-    result = {"command": "python benchmarks/critic_guided_acting.py " + " ".join(sys.argv[1:] if argv is None else argv),
+    result = {"command": command_line("critic_guided_acting.py", argv),
               "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "grid": GRID,
               "guided_minus_plain": by_radius, "runs": scored}
     write_result(args.json, result)

@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.actions import DESIRED_GOAL, GOAL_X, GOAL_Y, action_from_goal, goal_from_action  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -212,7 +212,7 @@ def main(argv=None) -> dict:
     if args.levels:
         rows = {name: level_summary([r for j, r in zip(jobs, done) if j[0] == name], ceilings[name]) for name in levels}
         result = {"benchmark": "goal_ceiling_levels", "robot": args.robot, "settings": {**settings, "episodes": args.episodes},
-                  "command": "python benchmarks/goal_ceiling.py " + " ".join(sys.argv[1:] if argv is None else argv), "levels": rows}
+                  "command": command_line("goal_ceiling.py", argv), "levels": rows}
         write_result(args.json, result)
         return result
     rows = {j[0]: r for j, r in zip(jobs, done)}

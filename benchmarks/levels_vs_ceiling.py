@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -34,12 +34,12 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--lbgp-policy", default=None, help="LBGP policy file (default: the shipped one)")
     args = ap.parse_args(argv)
     ceilings = {r["level"]: r["mean_bound"] for r in json.loads(Path(args.ceiling).read_text())["results"]}
-    command = "python benchmarks/levels_vs_ceiling.py " + " ".join(sys.argv[1:] if argv is None else argv)
+    command = command_line("levels_vs_ceiling.py", argv)
     out = {"command": command, "episodes": args.episodes, "ceilings": ceilings, "methods": {}}
     for method in args.methods.split(","):
         policy_file = args.lbgp_policy if method == "lbgp" else None
-        rows = evaluate(make_policy(method, policy_file=policy_file, robot="jackal"), method, level_names(), robot="jackal", episodes=args.episodes,
-                        seed=args.seed)
+        policy = make_policy(method, policy_file=policy_file, robot="jackal")
+        rows = evaluate(policy, method, level_names(), robot="jackal", episodes=args.episodes, seed=args.seed)
         out["methods"][method] = {r["scenario"]: {"mean_return": round(r["reward"], 3), "ci95": round(r.get("reward_ci95", 0.0), 3),
                                                   "share_of_ceiling": round(r["reward"] / ceilings[r["scenario"]], 3),
                                                   "collisions": int(r["collisions"])} for r in rows}

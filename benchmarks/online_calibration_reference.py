@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.experiments.real_protocol import PATHS, SETTINGS, run_setting  # noqa: E402
 from lbgp.online_calibration import OnlineCalibration  # noqa: E402
@@ -49,7 +49,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     t0 = time.perf_counter()
-    result = {"command": "python benchmarks/online_calibration_reference.py " + " ".join(sys.argv[1:]), "robots": {}}
+    result = {"command": command_line("online_calibration_reference.py"), "robots": {}}
     for robot in ("jackal", "turtlebot2"):
         result["robots"][robot] = {"where": "paper scenarios" + (" and real-world protocol (simulated mocap)" if robot == "turtlebot2" else ""),
                                    **summary(scenario_gains(robot, args.episodes, args.seed)

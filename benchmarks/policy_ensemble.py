@@ -23,7 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 from ablation_scenarios import scenario_seed  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -100,7 +100,7 @@ def main(argv: list[str] | None = None) -> dict:
         out.append({"members": members, "per_scenario": {n: rewards[(files, n)] for n in scenarios},
                     "sum": sum_of(files), "members_mean_sum": round(mean, 3),
                     "minus_members_mean": round(sum_of(files) - mean, 3)})
-    result = {"command": "python benchmarks/policy_ensemble.py " + " ".join(sys.argv[1:] if argv is None else argv),
+    result = {"command": command_line("policy_ensemble.py", argv),
               "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "ensembles": out}
     write_result(args.json, result)
     return result

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -39,7 +39,7 @@ def main() -> None:
     per_scenario = {r["scenario"]: {"episodes": per, "contacts": int(r["collisions"]), "loops": int(r.get("loops", 0)),
                                     "early_ends": int(r["terminated_early"]), "reward": round(r["reward"], 3)} for r in rows}
     result = {
-        "command": "python benchmarks/safety_sweep.py " + " ".join(sys.argv[1:]),
+        "command": command_line("safety_sweep.py"),
         "method": args.method, "policy": args.policy or "shipped", "episodes": per * len(names),
         "contacts": sum(v["contacts"] for v in per_scenario.values()),
         "loops": sum(v["loops"] for v in per_scenario.values()),

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 from sim2real_gap import identified_calibration  # noqa: E402
 
 from lbgp.dynamics import HARDWARE_LIKE, Dynamics  # noqa: E402
@@ -52,7 +52,7 @@ def main(argv: list[str] | None = None) -> dict:
     runs = {"nominal": ("nominal", None), "hardware_like": ("hardware_like", None),
             "hardware_like_calibrated": ("hardware_like", calibration),
             **{f"only_{name}": (dyn, None) for name, dyn in groups(robot).items()}}
-    result = {"command": "python benchmarks/sim2real_decomposition.py " + " ".join(sys.argv[1:] if argv is None else argv), "robot": robot,
+    result = {"command": command_line("sim2real_decomposition.py", argv), "robot": robot,
               "episodes": args.episodes, "calibration": identified, "methods": {}}
     t0 = time.perf_counter()
     for method in args.methods.split(","):

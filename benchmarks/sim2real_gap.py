@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 
 from lbgp.calibration import CommandCalibration  # noqa: E402
 from lbgp.dynamics import Dynamics  # noqa: E402
@@ -172,7 +172,7 @@ def main() -> None:
                     help="comma-separated subset of lbgp,hc,e2e,e2e_randomized (default: all; e2e_randomized needs --e2e-randomized)")
     ap.add_argument("--update", action="store_true", help="keep the other methods' entries of the existing --json file")
     args = ap.parse_args()
-    args.command = "python benchmarks/sim2real_gap.py " + " ".join(sys.argv[1:])
+    args.command = command_line("sim2real_gap.py")
 
     wanted = [m.strip() for m in args.methods.split(",") if m.strip()]
     unknown = set(wanted) - {"lbgp", "hc", "e2e", "e2e_randomized"}

@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 from ablation_scenarios import score  # noqa: E402
 from bench_planner import bench  # noqa: E402
 from goal_jitter import jitter_rewards  # noqa: E402
@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> dict:
     caps = [int(x) for x in args.iterations.split(",")]
     robots = args.robots.split(",")
     parts = set(args.parts.split(","))
-    result = {"command": "python benchmarks/sqp_iterations.py " + " ".join(sys.argv[1:] if argv is None else argv),
+    result = {"command": command_line("sqp_iterations.py", argv),
               "iterations": caps, "episodes_per_scenario": args.episodes}
     if "speed" in parts:  # alone on the machine, before the workers start
         result["speed"] = {robot: {str(k): {key: bench(robot, 20, args.calls, sqp_iterations=k)[key] for key in SPEED_KEYS}

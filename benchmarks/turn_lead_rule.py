@@ -23,7 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_result  # noqa: E402
+from _common import command_line, write_result  # noqa: E402
 from ablation_scenarios import score  # noqa: E402
 from goal_ceiling import TRAJECTORIES, TURNING  # noqa: E402
 
@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> dict:
     for name, row in rows.items():
         if name != "HC":
             row["minus_hc"] = {k: round(row[k] - hc[k], 3) for k in ("sum", *GROUPS) if k in row}
-    result = {"command": "python benchmarks/turn_lead_rule.py " + " ".join(sys.argv[1:] if argv is None else argv),
+    result = {"command": command_line("turn_lead_rule.py", argv),
               "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "rows": rows}
     write_result(args.json, result)
     return result

@@ -113,6 +113,9 @@ class D4PGConfig:
 
     # --- files
     checkpoint_every_s: float = 120.0
+    snapshot_every_s: float = 0.0  # > 0: also write the policy file every this many seconds of the run's
+    # wall time to snapshots/policy_<seconds>s.pt (a run's history of actors, for choosing one afterwards:
+    # benchmarks/snapshot_selection.py); 0: only the final policy.pt. Training is unchanged either way
     torch_threads: int = 1  # per process: the learner and each actor
 
     def validate(self) -> "D4PGConfig":
@@ -126,6 +129,8 @@ class D4PGConfig:
             from lbgp.dynamics import Randomization
 
             Randomization.from_dict(self.randomize, where="training config 'randomize'")
+        if not (math.isfinite(self.snapshot_every_s) and (self.snapshot_every_s == 0.0 or self.snapshot_every_s >= 1.0)):
+            raise ValueError(f"snapshot_every_s must be 0 (off) or at least 1 s, got {self.snapshot_every_s}")
         if not 0.0 <= self.spawn_front_share <= 1.0:
             raise ValueError(f"spawn_front_share must be in [0, 1], got {self.spawn_front_share}")
         if not 0.0 <= self.noise_correlation < 1.0:
@@ -161,7 +166,7 @@ class D4PGConfig:
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
-                "critic_future")
+                "critic_future", "snapshot_every_s")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

@@ -10,6 +10,9 @@ A run directory holds:
     policy.pt         the final policy file (see lbgp.agent.policy): the last actor, or with
                       ``policy_average`` the moving average of its weights
     policy_last.pt    with ``policy_average`` only: the last actor
+    snapshots/        with ``snapshot_every_s`` > 0: ``policy_<seconds>s.pt``, the policy file as it
+                      was at that wall time of the run (its meta: env steps, updates, level), for
+                      choosing an actor afterwards (benchmarks/snapshot_selection.py)
     summary.json      final counters and returns
     run.lock          held by the training process that uses the folder (a second one is refused)
 
@@ -228,6 +231,8 @@ class Trainer:
         interrupted = False
         t_start = time.monotonic() - self.wall_time
         last_ckpt = time.monotonic()
+        every = cfg.snapshot_every_s
+        next_snapshot = (self.wall_time // every + 1) * every if every else float("inf")
         update_clock = (time.monotonic(), self.learner.updates)
         ups = 0.0
         actors.start()
@@ -265,6 +270,9 @@ class Trainer:
                     if time.monotonic() - last_ckpt > cfg.checkpoint_every_s:
                         self.checkpoint()
                         last_ckpt = time.monotonic()
+                    if self.wall_time >= next_snapshot:
+                        self.snapshot()
+                        next_snapshot = (self.wall_time // every + 1) * every
                     if not actors.alive():
                         raise RuntimeError("all actor processes died; see their error output above")
         except (KeyboardInterrupt, Stop):
@@ -279,6 +287,18 @@ class Trainer:
             return self._finish(interrupted)
         finally:
             self.lock.release()
+
+    def snapshot(self) -> Path:
+        """Write the policy file as it is now to ``snapshots/policy_<wall seconds>s.pt``."""
+        cfg = self.cfg
+        path = self.dir / "snapshots" / f"policy_{int(self.wall_time):06d}s.pt"
+        path.parent.mkdir(exist_ok=True)
+        meta = {"method": cfg.method, "robot": cfg.robot, "seed": cfg.seed, "env_steps": self.env_steps,
+                "learner_updates": self.learner.updates, "wall_time_s": round(self.wall_time, 1),
+                "level": self.curriculum.level}
+        save_policy(path, self.learner.policy_actor, cfg.method, cfg.robot, cfg.hidden, extra=meta,
+                    residual_scale=cfg.actor_residual_scale)
+        return path
 
     def close(self) -> None:
         """Give the run folder back (its lock) without running: ``run`` does this itself."""

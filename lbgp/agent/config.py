@@ -115,7 +115,8 @@ class D4PGConfig:
     checkpoint_every_s: float = 120.0
     snapshot_every_s: float = 0.0  # > 0: also write the policy file every this many seconds of the run's
     # wall time to snapshots/policy_<seconds>s.pt (a run's history of actors, for choosing one afterwards:
-    # benchmarks/snapshot_selection.py); 0: only the final policy.pt. Training is unchanged either way
+    # benchmarks/snapshot_selection.py); 0: only the final policy.pt. Training is unchanged either way.
+    # Choosing by held-out training-level episodes over 3 runs: +0.17 +- 3.45 vs the last actor (docs/training.md)
     torch_threads: int = 1  # per process: the learner and each actor
 
     def validate(self) -> "D4PGConfig":

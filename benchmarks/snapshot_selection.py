@@ -35,7 +35,9 @@ from ablation_scenarios import run_policies, score  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from lbgp.agent.policy import load_policy  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
+from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import level_names, scenario_names  # noqa: E402
 
@@ -91,14 +93,10 @@ def select(run: dict, from_s: float) -> dict:
 
 
 def over_runs(differences: list[float]) -> dict:
-    mean = float(np.mean(differences)) if differences else None
-    half = None
-    if len(differences) >= 2:
-        from scipy import stats
-
-        half = float(stats.t.ppf(0.975, len(differences) - 1) * np.std(differences, ddof=1) / np.sqrt(len(differences)))
-    return {"per_run": [round(d, 3) for d in differences], "mean": None if mean is None else round(mean, 3),
-            "ci95_half_width": None if half is None else round(half, 3),
+    """The runs' differences, their mean and its 95 % t half-width (None with fewer than two runs)."""
+    mean = round(float(np.mean(differences)), 3) if differences else None
+    half = round(reward_ci95(differences), 3) if len(differences) >= 2 else None
+    return {"per_run": [round(d, 3) for d in differences], "mean": mean, "ci95_half_width": half,
             "separated": None if half is None else bool(abs(mean) > half)}
 
 
@@ -120,8 +118,6 @@ def main(argv: list[str] | None = None) -> dict:
     runs: dict[str, dict] = {}
     jobs_v, jobs_t = [], []
     for run, final in policies.items():
-        from lbgp.agent.policy import load_policy
-
         final_s = float(load_policy(final).meta.get("extra", {}).get("wall_time_s", float("inf")))
         files = run_files(final.parent)
         if len(files) == 1:

@@ -296,9 +296,12 @@ class Trainer:
         meta = {"method": cfg.method, "robot": cfg.robot, "seed": cfg.seed, "env_steps": self.env_steps,
                 "learner_updates": self.learner.updates, "wall_time_s": round(self.wall_time, 1),
                 "level": self.curriculum.level}
-        save_policy(path, self.learner.policy_actor, cfg.method, cfg.robot, cfg.hidden, extra=meta,
-                    residual_scale=cfg.actor_residual_scale)
+        self._save_policy(path, self.learner.policy_actor, meta)
         return path
+
+    def _save_policy(self, path: Path, actor, extra: dict) -> None:
+        cfg = self.cfg
+        save_policy(path, actor, cfg.method, cfg.robot, cfg.hidden, extra=extra, residual_scale=cfg.actor_residual_scale)
 
     def close(self) -> None:
         """Give the run folder back (its lock) without running: ``run`` does this itself."""
@@ -328,10 +331,8 @@ class Trainer:
         }
         if self.learner.average_actor is not None:  # the last raw actor too, beside the average
             summary["policy_average"] = cfg.policy_average
-            save_policy(self.dir / "policy_last.pt", self.learner.actor, cfg.method, cfg.robot, cfg.hidden,
-                        extra={**summary, "policy_average": 0.0}, residual_scale=cfg.actor_residual_scale)
-        save_policy(self.dir / "policy.pt", self.learner.policy_actor, cfg.method, cfg.robot, cfg.hidden, extra=summary,
-                    residual_scale=cfg.actor_residual_scale)
+            self._save_policy(self.dir / "policy_last.pt", self.learner.actor, {**summary, "policy_average": 0.0})
+        self._save_policy(self.dir / "policy.pt", self.learner.policy_actor, summary)
         write_json(self.dir / "summary.json", summary)
         return summary
 

@@ -38,6 +38,21 @@ def test_a_run_writes_a_policy_snapshot_every_interval_of_wall_time(tmp_path):
         D4PGConfig(snapshot_every_s=0.5).validate()
 
 
+def test_a_resumed_run_continues_the_snapshot_schedule_without_overwriting(tmp_path):
+    cfg = D4PGConfig(total_steps=400, min_replay=100, horizon=10, hidden=(16,), batch_size=16, seed=4, snapshot_every_s=1.0)
+    first = train(cfg, tmp_path / "run", backend="inline", progress=False)
+    before = {f.name: f.read_bytes() for f in (tmp_path / "run" / "snapshots").glob("policy_*s.pt")}
+    assert before, "the first part should have lasted over a second"
+    train(D4PGConfig(total_steps=800), tmp_path / "run", resume=True, backend="inline", progress=False)
+    files = sorted((tmp_path / "run" / "snapshots").glob("policy_*s.pt"))
+    later = [f for f in files if f.name not in before]
+    assert all(f.read_bytes() == before[f.name] for f in files if f.name in before)  # none rewritten
+    assert later, "the resumed part should have written snapshots too"
+    for f in later:  # named by the run's wall time, counted on from the checkpoint, with later actors
+        meta = load_policy(f).meta["extra"]
+        assert int(f.stem.split("_")[1].rstrip("s")) > first["wall_time_s"] - 1 and meta["env_steps"] > first["env_steps"]
+
+
 def _run_with_a_bad_snapshot(root: Path) -> Path:
     """A run folder whose final policy and 200 s snapshot are the shipped policy and whose 100 s
     snapshot is that policy with its residual pushed to the edge of its box (goal 0.75 m off)."""

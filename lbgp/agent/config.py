@@ -65,6 +65,11 @@ class D4PGConfig:
     hidden: tuple = (128, 128)  # actor and critic MLP sizes (acme: 256-512 wide; CPU budget here)
     grad_clip: float = 40.0  # global-norm clip (acme)
     replay_capacity: int = 500_000
+    priority_exponent: float = 0.0  # > 0: prioritised replay for the critic (lbgp.agent.prioritized_replay;
+    # Schaul et al.: 0.6), transitions drawn in proportion to (critic loss + 1e-3) ** this; the actor
+    # learns from a uniform batch. 0: uniform replay (acme's D4PG, the paper)
+    priority_correction: float = 0.4  # importance-weight exponent of prioritised replay (Schaul et al.: 0.4,
+    # held fixed here: a run's length in wall time is not known in advance to anneal it to 1)
     min_replay: int = 2_000  # learning starts after this many transitions (acme 1,000)
     max_updates_per_step: float = 2.0  # the learner runs at most this many updates per env step
     # collected (the actors are planner-bound at ~100 steps/s, the learner does ~240 updates/s at batch 256)
@@ -159,6 +164,8 @@ class D4PGConfig:
                 raise ValueError(f"{name} must be in (0, 1), got {getattr(self, name)}")
         if self.critic_future and self.mirror_augment:
             raise ValueError("critic_future and mirror_augment cannot be combined (the hindsight features are not mirrored)")
+        if not (0.0 <= self.priority_exponent <= 1.0 and 0.0 <= self.priority_correction <= 1.0):
+            raise ValueError(f"priority_exponent and priority_correction must be in [0, 1], got {self.priority_exponent}, {self.priority_correction}")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -167,7 +174,7 @@ class D4PGConfig:
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
-                "critic_future", "snapshot_every_s")
+                "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

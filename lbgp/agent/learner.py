@@ -67,7 +67,10 @@ class D4PGLearner:
             net.set_obs_stats(critic_in.mean(0), critic_in.std(0))
         self.obs_stats_set = True
 
-    def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
+    def update(self, batch: dict[str, torch.Tensor], actor_batch: dict[str, torch.Tensor] | None = None) -> dict[str, float]:
+        """One critic and (after the warm-up) one actor step. A prioritised batch carries importance
+        ``weight``s for the critic's loss; ``actor_batch``: the actor's own batch (default: ``batch``).
+        Each transition's critic loss is left in ``self.sample_losses`` (for new priorities)."""
         obs, action = batch["obs"], batch["action"]
         # critic: cross-entropy to the projected n-step target distribution
         with torch.no_grad():
@@ -75,13 +78,15 @@ class D4PGLearner:
             next_probs = torch.softmax(self.target_critic(batch["next_obs"], next_action), dim=-1)
             target = categorical_projection(next_probs, batch["ret"], batch["discount"], self.critic.atoms)
         logits = self.critic(obs, action)
-        critic_loss = -(target * F.log_softmax(logits, dim=-1)).sum(-1).mean()
+        sample_losses = -(target * F.log_softmax(logits, dim=-1)).sum(-1)
+        critic_loss = (sample_losses * batch["weight"]).mean() if "weight" in batch else sample_losses.mean()
+        self.sample_losses = sample_losses.detach().numpy()
         self.critic_opt.zero_grad(set_to_none=True)
         critic_loss.backward()
         torch.nn.utils.clip_grad_norm_(self.critic.parameters(), self.cfg.grad_clip)
         self.critic_opt.step()
 
-        actor_loss, q = self.actor_loss(obs)
+        actor_loss, q = self.actor_loss(obs if actor_batch is None else actor_batch["obs"])
         if self.updates >= self.cfg.actor_warmup_updates:
             self.actor_opt.zero_grad(set_to_none=True)
             actor_loss.backward()

@@ -41,6 +41,7 @@ from lbgp.agent.curriculum import Curriculum
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
 from lbgp.agent.previous_goal import agent_input_size
+from lbgp.agent.prioritized_replay import PrioritizedReplayBuffer
 from lbgp.agent.replay import ReplayBuffer, mirrored
 
 CHECKPOINT_FORMAT = "lbgp-checkpoint"
@@ -114,7 +115,11 @@ class Trainer:
         torch.manual_seed(cfg.seed)
         self.rng = np.random.default_rng(cfg.seed)
         self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
-        self.replay = ReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2)
+        if cfg.priority_exponent > 0:
+            self.replay = PrioritizedReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2,
+                                                  cfg.priority_exponent, cfg.priority_correction)
+        else:
+            self.replay = ReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2)
         self.curriculum = Curriculum(cfg.curriculum, cfg.level_thresholds, cfg.level_budget_fraction, cfg.total_steps,
                                      cfg.curriculum_window, cfg.time_limit_s)
         self.env_steps = 0
@@ -215,6 +220,16 @@ class Trainer:
             if self.curriculum.record(level, ret, self.env_steps, self.wall_time):
                 self.level_times[self.curriculum.level] = self.wall_time
 
+    def _learn_once(self) -> None:
+        """One learner update from the replay (prioritised: the critic's batch by priority, the
+        actor's uniform, and the critic's batch gets new priorities)."""
+        batch = self.replay.sample(self.cfg.batch_size, self.rng)
+        if not isinstance(self.replay, PrioritizedReplayBuffer):
+            self.learner.update(batch)
+            return
+        self.learner.update(batch, self.replay.sample_uniform(self.cfg.batch_size, self.rng))
+        self.replay.update_priorities(batch["index"].numpy(), self.learner.sample_losses)
+
     def run(self) -> dict:
         cfg = self.cfg
         actors = self._make_actors()
@@ -255,7 +270,7 @@ class Trainer:
                             self.learner.set_obs_stats(self.replay.obs[: len(self.replay)])
                         due = int(cfg.max_updates_per_step * self.env_steps) - self.learner.updates
                         for _ in range(max(due, 0) if getattr(actors, "synchronous", False) else 10):
-                            self.learner.update(self.replay.sample(cfg.batch_size, self.rng))
+                            self._learn_once()
                         if self.learner.updates % 50 == 0:
                             actors.board.publish(flat_parameters(self.learner.actor))
                     self.wall_time = time.monotonic() - t_start

@@ -46,6 +46,7 @@ class D4PGLearner:
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, foreach=True)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
         self.updates = 0
+        self.sample_losses = None  # each transition's critic loss in the last update's batch
         # LBGP's goal prior (cfg.prior_weight): a residual actor's base (the goal 1.5 m straight ahead
         # of the person, turn-aware with cfg.turn_lead), a plain actor's the goal ahead
         self.prior = torch.as_tensor(action_from_goal(DESIRED_GOAL), dtype=torch.float32)

@@ -74,11 +74,10 @@ class PrioritizedReplayBuffer(ReplayBuffer):
         self.tree = SumTree(self.capacity)
         self.max_priority = 1.0
 
-    def add_batch(self, obs, action, ret, discount, next_obs) -> None:
-        n = len(ret)
-        idx = (self.cursor + np.arange(n)) % self.capacity
-        super().add_batch(obs, action, ret, discount, next_obs)
-        self.tree.set(idx, np.full(n, self.max_priority))
+    def add_batch(self, obs, action, ret, discount, next_obs) -> np.ndarray:
+        idx = super().add_batch(obs, action, ret, discount, next_obs)
+        self.tree.set(idx, np.full(len(idx), self.max_priority))
+        return idx
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
         """A prioritised batch (stratified: one draw in each of ``batch_size`` equal slices of the
@@ -107,14 +106,14 @@ class PrioritizedReplayBuffer(ReplayBuffer):
 
     def state_dict(self) -> dict:
         state = super().state_dict()
-        n = self.size
-        order = np.arange(n) if n < self.capacity else (self.cursor + np.arange(n)) % self.capacity
-        state["priority"] = torch.from_numpy(self.tree.leaf_values(order).copy())
+        state["priority"] = torch.from_numpy(self.tree.leaf_values(self.oldest_first()).copy())
         return state
 
     def load_state_dict(self, state: dict) -> None:
+        # every transition comes back at the largest priority (add_batch); a prioritised run's
+        # checkpoint then restores its own (a uniform run's has none)
         super().load_state_dict({f: v for f, v in state.items() if f != "priority"})
-        if "priority" in state and self.size:  # a checkpoint of a uniform run: every transition at max priority
+        if "priority" in state and self.size:
             priority = state["priority"].numpy()[-self.size :]
             self.tree.set(np.arange(self.size), priority)
             self.max_priority = max(1.0, float(priority.max()))

@@ -35,13 +35,20 @@ class ReplayBuffer:
     def __len__(self) -> int:
         return self.size
 
-    def add_batch(self, obs, action, ret, discount, next_obs) -> None:
+    def add_batch(self, obs, action, ret, discount, next_obs) -> np.ndarray:
+        """Store the transitions; returns the slots they went to."""
         n = len(ret)
         idx = (self.cursor + np.arange(n)) % self.capacity
         self.obs[idx], self.action[idx], self.ret[idx] = obs, action, ret
         self.discount[idx], self.next_obs[idx] = discount, next_obs
         self.cursor = int((self.cursor + n) % self.capacity)
         self.size = int(min(self.size + n, self.capacity))
+        return idx
+
+    def oldest_first(self) -> np.ndarray:
+        """The slots that hold transitions, from the oldest to the newest."""
+        n = self.size
+        return np.arange(n) if n < self.capacity else (self.cursor + np.arange(n)) % self.capacity
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
         if self.size == 0:
@@ -51,8 +58,7 @@ class ReplayBuffer:
 
     # -- checkpointing (tensors only, so that torch.load(weights_only=True) can read it)
     def state_dict(self) -> dict:
-        n = self.size
-        order = np.arange(n) if n < self.capacity else (self.cursor + np.arange(n)) % self.capacity
+        order = self.oldest_first()
         return {f: torch.from_numpy(getattr(self, f)[order].copy()) for f in FIELDS}
 
     def load_state_dict(self, state: dict) -> None:

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+import torch
 
 from lbgp.cli import default_policy_path, main
 from lbgp.viz.recording import ENTITY_PATHS, entity_paths_in
@@ -152,6 +153,23 @@ def test_train_set_changes_only_the_named_fields_over_the_preset(tmp_path):
     config = json.loads((paper / "config.json").read_text())
     assert config["sigma"] == 0.1 and config["batch_size"] == 64  # the last --set wins
     assert config["residual_scale"] == 0.0 and config["spawn_front_share"] == 0.5  # the rest: the paper's
+
+
+def test_train_set_takes_layer_sizes_and_target_updates(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["train", "--set", "hidden=32,16", "--set", "target_tau=0.01", "--set", "target_update_period=7",
+                 "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    config = json.loads((run / "config.json").read_text())
+    assert config["hidden"] == [32, 16] and config["target_tau"] == 0.01 and config["target_update_period"] == 7
+    from lbgp.agent.policy import load_policy
+
+    layers = [m.out_features for m in load_policy(run / "policy.pt").actor.modules() if isinstance(m, torch.nn.Linear)]
+    assert layers[:2] == [32, 16]  # the policy file's actor was built with the layers asked for
+    for bad, words in (("hidden=32,none", "layer sizes"), ("hidden=0", "hidden"), ("target_tau=1.5", "target_tau"),
+                       ("target_update_period=0", "target_update_period")):
+        assert main(["train", "--set", bad, "--steps", "40", "--backend", "inline", "--out", str(tmp_path / "bad")]) == 2
+        assert words in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()  # refused before anything is written
 
 
 def test_train_resume_refuses_options_it_would_ignore(tmp_path, capsys):

@@ -168,6 +168,10 @@ class D4PGConfig:
             raise ValueError("critic_future and mirror_augment cannot be combined (the hindsight features are not mirrored)")
         if not (0.0 <= self.priority_exponent <= 1.0 and 0.0 <= self.priority_correction <= 1.0):
             raise ValueError(f"priority_exponent and priority_correction must be in [0, 1], got {self.priority_exponent}, {self.priority_correction}")
+        if not (len(self.hidden) >= 1 and all(isinstance(h, int) and 1 <= h <= 4096 for h in self.hidden)):
+            raise ValueError(f"hidden must be 1+ layer sizes from 1 to 4096, got {self.hidden}")
+        if self.target_update_period < 1 or not 0.0 <= self.target_tau <= 1.0:
+            raise ValueError(f"target_update_period must be >= 1 and target_tau in [0, 1], got {self.target_update_period}, {self.target_tau}")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -176,7 +180,8 @@ class D4PGConfig:
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
-                "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction")
+                "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction", "hidden",
+                "target_update_period", "target_tau")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:
@@ -194,6 +199,11 @@ class D4PGConfig:
             if raw.lower() not in words:
                 raise ValueError(f"{name} takes true or false, got {raw!r}")
             value = words[raw.lower()]
+        elif kind is tuple:  # layer sizes: "256,256" (or "256x256")
+            try:
+                value = tuple(int(part) for part in raw.replace("x", ",").split(","))
+            except ValueError:
+                raise ValueError(f"{name} takes layer sizes like 256,256, got {raw!r}") from None
         else:
             try:
                 value = kind(raw)

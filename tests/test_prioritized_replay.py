@@ -75,6 +75,24 @@ def test_priorities_survive_a_checkpoint_also_after_the_ring_wrapped():
     assert np.allclose(fresh.tree.leaf_values([0, 1, 2]), 1.0) and fresh.tree.total == pytest.approx(3.0)
 
 
+def test_an_inconsistent_checkpoint_replay_is_refused_by_name_and_leaves_the_buffer_as_it_was():
+    buf = filled(n=6)
+    state = buf.state_dict()
+    cases = (({**state, "priority": state["priority"][:4]}, "priorities"),
+             ({**state, "priority": torch.full((6,), float("nan"))}, "priorities"),
+             ({**state, "next_obs": state["next_obs"][:5]}, "'next_obs'"),
+             ({**state, "action": torch.zeros(6, 3)}, "'action'"),
+             ({f: v for f, v in state.items() if f != "discount"}, "lacks discount"))
+    for bad, words in cases:
+        target = filled(n=2)
+        with pytest.raises(ValueError, match=words):
+            target.load_state_dict(bad)
+        assert target.size == 2 and target.tree.total == pytest.approx(2.0)  # untouched
+    plain = ReplayBuffer(8, 3, 2)
+    with pytest.raises(ValueError, match="'obs' has shape"):
+        plain.load_state_dict({**state, "obs": torch.zeros(6, 4)})
+
+
 def test_the_critic_loss_is_weighted_and_the_actor_learns_from_its_own_batch():
     cfg = D4PGConfig(hidden=(16,), actor_warmup_updates=0, normalize_obs=False, seed=0)
     torch.manual_seed(0)

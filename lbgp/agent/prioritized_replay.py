@@ -112,8 +112,13 @@ class PrioritizedReplayBuffer(ReplayBuffer):
     def load_state_dict(self, state: dict) -> None:
         # every transition comes back at the largest priority (add_batch); a prioritised run's
         # checkpoint then restores its own (a uniform run's has none)
+        if "priority" in state:
+            priority = state["priority"].numpy()
+            if priority.shape != (len(state.get("ret", ())),) or not np.all(np.isfinite(priority) & (priority > 0)):
+                raise ValueError(f"checkpoint replay's priorities must be one positive finite number per transition "
+                                 f"({len(state.get('ret', ()))}), got shape {priority.shape}")
         super().load_state_dict({f: v for f, v in state.items() if f != "priority"})
         if "priority" in state and self.size:
-            priority = state["priority"].numpy()[-self.size :]
+            priority = priority[-self.size :]
             self.tree.set(np.arange(self.size), priority)
             self.max_priority = max(1.0, float(priority.max()))

@@ -62,7 +62,16 @@ class ReplayBuffer:
         return {f: torch.from_numpy(getattr(self, f)[order].copy()) for f in FIELDS}
 
     def load_state_dict(self, state: dict) -> None:
+        missing = [f for f in FIELDS if f not in state]
+        if missing:
+            raise ValueError(f"checkpoint replay lacks {', '.join(missing)}")
         n = len(state["ret"])
+        widths = {"obs": self.obs.shape[1], "action": self.action.shape[1], "next_obs": self.next_obs.shape[1]}
+        for f in FIELDS:
+            shape = tuple(state[f].shape)
+            if shape[0] != n or shape[1:] != ((widths[f],) if f in widths else ()):
+                want = (n, widths[f]) if f in widths else (n,)
+                raise ValueError(f"checkpoint replay field {f!r} has shape {shape}, expected {want}")
         if n > self.capacity:
             state = {f: v[-self.capacity :] for f, v in state.items()}
             n = self.capacity

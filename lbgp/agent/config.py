@@ -49,6 +49,7 @@ class D4PGConfig:
     # (1e-4 for both over 3 seeds: +0.1 +- 3.4 on the paper scenarios, not separated; docs/training.md)
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
+    # (soft updates, target_tau 0.005, over 3 seeds: 0.4 +- 3.7 lower on the paper scenarios, not separated)
     target_tau: float = 0.0  # > 0: soft (Polyak) target update by this much every step instead of hard updates
     policy_average: float = 0.0  # > 0: the policy file holds an exponential moving average of the actor's
     # weights, moved this much toward the actor after every update from the end of the actor warm-up
@@ -64,6 +65,7 @@ class D4PGConfig:
     v_min: float = -30.0  # acme [-150, 150] is for rewards ~1/step over 1000 steps; here rewards are in
     v_max: float = 30.0  # [-1, 1] and 1 / (1 - 0.97) = 33: +-30 covers every discounted return
     hidden: tuple = (128, 128)  # actor and critic MLP sizes (acme: 256-512 wide; CPU budget here)
+    # (256-256 over 3 seeds at equal wall time, half the updates: 1.0 +- 3.7 lower, not separated; docs/training.md)
     grad_clip: float = 40.0  # global-norm clip (acme)
     replay_capacity: int = 500_000
     priority_exponent: float = 0.0  # > 0: prioritised replay for the critic (lbgp.agent.prioritized_replay;

@@ -82,7 +82,8 @@ def test_an_inconsistent_checkpoint_replay_is_refused_by_name_and_leaves_the_buf
              ({**state, "priority": torch.full((6,), float("nan"))}, "priorities"),
              ({**state, "next_obs": state["next_obs"][:5]}, "'next_obs'"),
              ({**state, "action": torch.zeros(6, 3)}, "'action'"),
-             ({f: v for f, v in state.items() if f != "discount"}, "lacks discount"))
+             ({f: v for f, v in state.items() if f != "discount"}, "lacks discount"),
+             ({f: v for f, v in state.items() if f != "ret"}, "lacks ret"))
     for bad, words in cases:
         target = filled(n=2)
         with pytest.raises(ValueError, match=words):

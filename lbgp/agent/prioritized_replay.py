@@ -113,10 +113,11 @@ class PrioritizedReplayBuffer(ReplayBuffer):
         # every transition comes back at the largest priority (add_batch); a prioritised run's
         # checkpoint then restores its own (a uniform run's has none)
         if "priority" in state:
+            n = self.checked_length(state)  # the transitions' fields first, so a missing one is named as such
             priority = state["priority"].numpy()
-            if priority.shape != (len(state.get("ret", ())),) or not np.all(np.isfinite(priority) & (priority > 0)):
+            if priority.shape != (n,) or not np.all(np.isfinite(priority) & (priority > 0)):
                 raise ValueError(f"checkpoint replay's priorities must be one positive finite number per transition "
-                                 f"({len(state.get('ret', ()))}), got shape {priority.shape}")
+                                 f"({n}), got shape {priority.shape}")
         super().load_state_dict({f: v for f, v in state.items() if f != "priority"})
         if "priority" in state and self.size:
             priority = priority[-self.size :]

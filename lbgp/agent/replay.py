@@ -61,7 +61,9 @@ class ReplayBuffer:
         order = self.oldest_first()
         return {f: torch.from_numpy(getattr(self, f)[order].copy()) for f in FIELDS}
 
-    def load_state_dict(self, state: dict) -> None:
+    def checked_length(self, state: dict) -> int:
+        """The number of transitions in a checkpoint's replay ``state``; ValueError naming the field
+        that is missing or whose shape does not fit this buffer."""
         missing = [f for f in FIELDS if f not in state]
         if missing:
             raise ValueError(f"checkpoint replay lacks {', '.join(missing)}")
@@ -72,6 +74,10 @@ class ReplayBuffer:
             if shape[0] != n or shape[1:] != ((widths[f],) if f in widths else ()):
                 want = (n, widths[f]) if f in widths else (n,)
                 raise ValueError(f"checkpoint replay field {f!r} has shape {shape}, expected {want}")
+        return n
+
+    def load_state_dict(self, state: dict) -> None:
+        n = self.checked_length(state)
         if n > self.capacity:
             state = {f: v[-self.capacity :] for f, v in state.items()}
             n = self.capacity

@@ -26,7 +26,7 @@ the paired control from the same training, its difference given per seed.
 
 ``--runs`` takes several folders and ``--variants`` picks variants, so that runs of another training
 choice kept elsewhere are compared with the ablation's LBGP runs on the same episodes, e.g. mirror
-augmentation in training (docs/training.md):
+augmentation in training (docs/ablations.md):
 ``--runs results/ablation_runs,results/mirror_augment_runs --variants LBGP,LBGP-mirror-augment``.
 """
 

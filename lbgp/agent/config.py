@@ -43,10 +43,10 @@ class D4PGConfig:
     # --- learner
     n_step: int = 5  # (acme); 10 over 3 seeds: 1.2 +- 4.8 lower on the paper scenarios (not separated)
     discount: float = 0.97  # acme 0.99; 0.97 (effective horizon ~33 steps) matches 35-step episodes
-    # 0.9 over 3 seeds: 0.2 +- 3.7 lower on the paper scenarios (not separated; docs/training.md)
+    # 0.9 over 3 seeds: 0.2 +- 3.7 lower on the paper scenarios (not separated; docs/ablations.md)
     batch_size: int = 256  # (acme)
     actor_lr: float = 3e-4  # acme 1e-4; 3e-4 learns faster within the ~100k updates a 2-core budget allows
-    # (1e-4 for both over 3 seeds: +0.1 +- 3.4 on the paper scenarios, not separated; docs/training.md)
+    # (1e-4 for both over 3 seeds: +0.1 +- 3.4 on the paper scenarios, not separated; docs/ablations.md)
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
     # (soft updates, target_tau 0.005, over 3 seeds: 0.4 +- 3.7 lower on the paper scenarios, not separated)
@@ -55,23 +55,23 @@ class D4PGConfig:
     # weights, moved this much toward the actor after every update from the end of the actor warm-up
     # (1e-4: a window of ~10k updates); the run also keeps the last raw actor as policy_last.pt. Training
     # itself (actors, targets, curve) is unchanged. 0: the policy file is the last actor (the paper).
-    # Measured at 1e-4 over 3 seeds (docs/training.md): the average minus the last actor of the same run
+    # Measured at 1e-4 over 3 seeds (docs/ablations.md): the average minus the last actor of the same run
     # -1.5 +- 6.6 summed over the paper scenarios (not separated), so it stays off
     prior_weight: float = 1.0  # LBGP only (not in the paper): the actor loss adds this * |a - a_ahead|^2,
     # a_ahead = the goal 1.5 m ahead. Keeps goals near the sensible default wherever the critic has no
     # clear preference (without it the goals jump step to step); 0 = plain D4PG. E2E: always 0.
-    # Over 3 seeds, 0.3 scored 4.8 +- 5.9 and 3 scored 0.9 +- 7.1 lower (neither separated; docs/training.md)
+    # Over 3 seeds, 0.3 scored 4.8 +- 5.9 and 3 scored 0.9 +- 7.1 lower (neither separated; docs/ablations.md)
     num_atoms: int = 51  # (acme)
     v_min: float = -30.0  # acme [-150, 150] is for rewards ~1/step over 1000 steps; here rewards are in
     v_max: float = 30.0  # [-1, 1] and 1 / (1 - 0.97) = 33: +-30 covers every discounted return
     hidden: tuple = (128, 128)  # actor and critic MLP sizes (acme: 256-512 wide; CPU budget here)
-    # (256-256 over 3 seeds at equal wall time, half the updates: 1.0 +- 3.7 lower, not separated; docs/training.md)
+    # (256-256 over 3 seeds at equal wall time, half the updates: 1.0 +- 3.7 lower, not separated; docs/ablations.md)
     grad_clip: float = 40.0  # global-norm clip (acme)
     replay_capacity: int = 500_000
     priority_exponent: float = 0.0  # > 0: prioritised replay for the critic (lbgp.agent.prioritized_replay;
     # Schaul et al.: 0.6), transitions drawn in proportion to (critic loss + 1e-3) ** this; the actor
     # learns from a uniform batch. 0: uniform replay (acme's D4PG, the paper). Off: over 3 seeds 0.6
-    # scored 2.0 +- 6.9 lower on the paper scenarios (not separated; docs/training.md)
+    # scored 2.0 +- 6.9 lower on the paper scenarios (not separated; docs/ablations.md)
     priority_correction: float = 0.4  # importance-weight exponent of prioritised replay (Schaul et al.: 0.4,
     # held fixed here: a run's length in wall time is not known in advance to anneal it to 1)
     min_replay: int = 2_000  # learning starts after this many transitions (acme 1,000)
@@ -80,21 +80,21 @@ class D4PGConfig:
 
     actor_warmup_updates: int = 5_000  # the actor stays fixed for the critic's first updates: a random
     # critic's gradient would push a residual actor off its base goal before anything was learnt (0: paper)
-    # Over 3 seeds, 0 scored 3.6 +- 9.6 lower: not separated, kept as the default (docs/training.md).
+    # Over 3 seeds, 0 scored 3.6 +- 9.6 lower: not separated, kept as the default (docs/ablations.md).
 
     # --- LBGP's goal policy (see lbgp/agent/networks.py and docs/training.md)
     residual_scale: float = 0.375  # > 0: the actor outputs the goal 1.5 m ahead plus a residual bounded by
     # this (action units: 0.375 = 0.75 m), its last layer initialised to zero; 0 = the paper's plain actor.
     # E2E: always plain. Over 3 seeds a plain actor trailed by 8.2 +- 16.2 on the paper scenarios (not separated)
-    # and a wider residual (0.5: +-1.0 m) by 1.6 +- 3.6 (not separated): docs/training.md
+    # and a wider residual (0.5: +-1.0 m) by 1.6 +- 3.6 (not separated): docs/ablations.md
     turn_lead: float = 0.0  # m per rad/s: the residual's base goal moves this much farther ahead per
     # rad/s of the person's turn rate seen in the observation (a turn-aware base); 0 = the goal 1.5 m ahead
     motion_features: bool = False  # actor and critic also see the person's velocity and turn rate and the
     # robot's velocity, read linearly off the observation (lbgp.sim.observation.motion_feature_weights);
-    # the observation itself, and so the deploy loop, is unchanged. Off: measured over 3 seeds, docs/training.md
+    # the observation itself, and so the deploy loop, is unchanged. Off: measured over 3 seeds, docs/ablations.md
     previous_goal: bool = False  # actor and critic also see the action sent one step before (the previous
     # goal; lbgp.agent.previous_goal): the policy's only memory, carried by Policy between act calls.
-    # Off: over 3 seeds it lost 6.5 +- 5.8 on the paper scenarios (160.3 vs 166.8; docs/training.md)
+    # Off: over 3 seeds it lost 6.5 +- 5.8 on the paper scenarios (160.3 vs 166.8; docs/ablations.md)
     normalize_obs: bool = True  # standardise the observation (mean/std of the first min_replay transitions);
     # over 3 seeds raw inputs scored 1.0 +- 5.7 higher (not separated): on because the shipped policy has it
     randomize: dict = dataclasses.field(default_factory=dict)  # domain randomisation ranges per episode
@@ -102,17 +102,17 @@ class D4PGConfig:
     mirror_augment: bool = False  # also store every transition's mirror image about the person's heading
     # line in the replay (observation and next observation mirrored, the action's lateral part negated,
     # same return): the task is symmetric, so each episode teaches both turn directions. Off: over 3
-    # seeds it did not beat mirror-averaged acting alone (166.1 vs 168.2 on the paper scenarios; docs/training.md)
+    # seeds it did not beat mirror-averaged acting alone (166.1 vs 168.2 on the paper scenarios; docs/ablations.md)
     drawn_paths: bool = False  # the trajectories level draws a fresh person path every episode
     # (lbgp.sim.tasks.drawn_paths_setting) instead of walking one of the library's 20
-    # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/training.md)
+    # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/ablations.md)
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
     # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
     # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
-    # Off: over 3 seeds it scored 0.8 +- 6.4 lower on the paper scenarios (not separated; docs/training.md)
+    # Off: over 3 seeds it scored 0.8 +- 6.4 lower on the paper scenarios (not separated; docs/ablations.md)
     spawn_front_share: float = 0.75  # share of training spawns in front of the person (|alpha| < 90 deg);
     # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn. Over 3 seeds uniform
-    # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/training.md)
+    # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/ablations.md)
 
     # --- curriculum (see lbgp/agent/curriculum.py)
     level_thresholds: tuple = (15.0, 12.0, 8.0)  # exploit return (mean over the window) to advance
@@ -125,7 +125,7 @@ class D4PGConfig:
     snapshot_every_s: float = 0.0  # > 0: also write the policy file every this many seconds of the run's
     # wall time to snapshots/policy_<seconds>s.pt (a run's history of actors, for choosing one afterwards:
     # benchmarks/snapshot_selection.py); 0: only the final policy.pt. Training is unchanged either way.
-    # Choosing by held-out training-level episodes over 3 runs: +0.17 +- 3.45 vs the last actor (docs/training.md)
+    # Choosing by held-out training-level episodes over 3 runs: +0.17 +- 3.45 vs the last actor (docs/ablations.md)
     torch_threads: int = 1  # per process: the learner and each actor
 
     def validate(self) -> "D4PGConfig":

@@ -15,7 +15,7 @@ The actor has two output forms:
   With ``turn_lead > 0`` the base is turn-aware: the goal ahead moves ``turn_lead`` metres farther
   per rad/s of the person's turn rate as the observation shows it
   (``lbgp.sim.observation.turn_rate_weights``), because a robot tracking a goal around a turning
-  person falls behind it (docs/training.md).
+  person falls behind it (docs/ablations.md).
 
 With ``motion_features`` both networks also see five motion estimates read linearly off the
 observation (the person's velocity and turn rate, the robot's velocity; ``motion_feature_weights``),

@@ -49,7 +49,8 @@ class D4PGConfig:
     # (1e-4 for both over 3 seeds: +0.1 +- 3.4 on the paper scenarios, not separated; docs/ablations.md)
     critic_lr: float = 3e-4  # (as the actor)
     target_update_period: int = 100  # hard target update every N learner steps (acme)
-    # (soft updates, target_tau 0.005, over 3 seeds: 0.4 +- 3.7 lower on the paper scenarios, not separated)
+    # (soft updates, target_tau 0.005, over 3 seeds: 0.4 +- 3.7 lower on the paper scenarios; a period of 20:
+    # 1.7 +- 5.6 lower; neither separated; docs/ablations.md)
     target_tau: float = 0.0  # > 0: soft (Polyak) target update by this much every step instead of hard updates
     policy_average: float = 0.0  # > 0: the policy file holds an exponential moving average of the actor's
     # weights, moved this much toward the actor after every update from the end of the actor warm-up

@@ -41,55 +41,58 @@ from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
 
-class SmoothedGoals:
-    """Wraps a goal policy: ``act`` returns ``s * previous + (1 - s) * policy.act(obs)``.
+class GoalFilter:
+    """Wraps a goal policy and filters its goals over an episode, from the goal it sent last
+    (``_last``, forgotten by ``reset``); subclasses say how in ``filtered``."""
+
+    def __init__(self, policy):
+        if getattr(policy, "control", None) != "goal":
+            raise ValueError(f"{type(self).__name__} needs a goal policy (control 'goal')")
+        self.policy, self.control, self._last = policy, "goal", None
+
+    def reset(self) -> None:
+        self._last = None
+        if hasattr(self.policy, "reset"):
+            self.policy.reset()
+
+    def act(self, observation) -> np.ndarray:
+        action = np.asarray(self.policy.act(observation), np.float32)
+        self._last = action if self._last is None else self.filtered(action)
+        return self._last
+
+    def filtered(self, action: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+
+class SmoothedGoals(GoalFilter):
+    """``act`` returns ``s * previous + (1 - s) * policy.act(obs)`` (the first step: the policy's).
 
     Goal actions are an affine map of the goal in metres (``lbgp.actions``), so averaging actions
     averages goals; a convex mix of two actions in [-1, 1]^2 stays in it."""
 
     def __init__(self, policy, smoothing: float):
-        if getattr(policy, "control", None) != "goal":
-            raise ValueError("goal smoothing needs a goal policy (control 'goal')")
+        super().__init__(policy)
         if not (np.isfinite(smoothing) and 0.0 <= smoothing < 1.0):
             raise ValueError(f"smoothing must be in [0, 1), got {smoothing!r}")
-        self.policy, self.smoothing, self.control = policy, float(smoothing), "goal"
-        self._last = None
+        self.smoothing = float(smoothing)
 
-    def reset(self) -> None:
-        self._last = None
-        if hasattr(self.policy, "reset"):
-            self.policy.reset()
-
-    def act(self, observation) -> np.ndarray:
-        action = np.asarray(self.policy.act(observation), np.float32)
-        if self._last is not None:
-            action = (self.smoothing * self._last + (1.0 - self.smoothing) * action).astype(np.float32)
-        self._last = action
-        return action
+    def filtered(self, action: np.ndarray) -> np.ndarray:
+        return (self.smoothing * self._last + (1.0 - self.smoothing) * action).astype(np.float32)
 
 
-class HeldGoals:
-    """Wraps a goal policy: ``act`` returns the goal it returned last until the policy's goal is
-    more than ``hold_m`` metres from it, then the policy's goal (the first step: the policy's)."""
+class HeldGoals(GoalFilter):
+    """``act`` returns the goal it returned last until the policy's goal is more than ``hold_m``
+    metres from it, then the policy's goal (the first step: the policy's)."""
 
     def __init__(self, policy, hold_m: float):
-        if getattr(policy, "control", None) != "goal":
-            raise ValueError("goal hold needs a goal policy (control 'goal')")
+        super().__init__(policy)
         if not (np.isfinite(hold_m) and hold_m >= 0.0):
             raise ValueError(f"hold must be a distance >= 0 m, got {hold_m!r}")
-        self.policy, self.hold_m, self.control = policy, float(hold_m), "goal"
-        self._last = None
+        self.hold_m = float(hold_m)
 
-    def reset(self) -> None:
-        self._last = None
-        if hasattr(self.policy, "reset"):
-            self.policy.reset()
-
-    def act(self, observation) -> np.ndarray:
-        action = np.asarray(self.policy.act(observation), np.float32)
-        if self._last is None or np.hypot(*(goal_from_action(action) - goal_from_action(self._last))) > self.hold_m:
-            self._last = action
-        return self._last
+    def filtered(self, action: np.ndarray) -> np.ndarray:
+        moved = np.hypot(*(goal_from_action(action) - goal_from_action(self._last)))
+        return action if moved > self.hold_m else self._last
 
 
 def acting_key(kind: str, value: float) -> str:

@@ -57,7 +57,7 @@ def test_smoothing_is_refused_outside_0_to_1_and_for_a_velocity_policy():
     for bad in (1.0, -0.1, float("nan")):
         with pytest.raises(ValueError, match="smoothing"):
             SmoothedGoals(goal_policy, bad)
-    with pytest.raises(ValueError, match="goal policy"):
+    with pytest.raises(ValueError, match="needs a goal policy"):
         SmoothedGoals(make_policy("e2e", robot="jackal"), 0.5)
 
 

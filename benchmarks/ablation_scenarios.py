@@ -94,15 +94,21 @@ def scenario_seed(seed: int, name: str) -> int:
     return seed + 1000 * scenario_names().index(name)
 
 
+def sim_table_rewards(policy, method: str, scenarios, episodes: int, seed: int, planner_config=None) -> dict[str, float]:
+    """``policy``'s mean reward (3 decimals) on each scenario's sim-table episodes (``scenario_seed``,
+    observation noise on, Jackal), by scenario name."""
+    rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=scenario_seed(seed, name),
+                     obs_noise=True, planner_config=planner_config)[0] for name in scenarios]
+    return {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
+
+
 def score(job: tuple) -> tuple[str, dict]:
     """job: (name, method, policy_file, scenarios, episodes, seed, deadband, mirror[, planner_changes]);
     ``planner_changes``: PlannerConfig fields to change from the Jackal's preset (default none)."""
     name, method, policy_file, scenarios, episodes, seed, deadband, mirror, *rest = job
     planner = planner_config_for("jackal").with_(**rest[0]) if rest and rest[0] else None
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
-    rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=scenario_seed(seed, name),
-                     obs_noise=True, planner_config=planner)[0] for name in scenarios]
-    per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
+    per_scenario = sim_table_rewards(policy, method, scenarios, episodes, seed, planner)
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
                   "mirror_average": getattr(policy, "mirror_average", None), "per_scenario": per_scenario,
                   "sum": round(float(sum(per_scenario.values())), 3)}

@@ -27,7 +27,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
-from ablation_scenarios import paired_difference, scenario_seed  # noqa: E402
+from ablation_scenarios import paired_difference, sim_table_rewards  # noqa: E402
 
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
@@ -38,7 +38,6 @@ from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.learner import D4PGLearner  # noqa: E402
 from lbgp.agent.policy import load_policy  # noqa: E402
 from lbgp.agent.train import CHECKPOINT_FORMAT  # noqa: E402
-from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 from lbgp.sim.observation import mirror  # noqa: E402
@@ -87,9 +86,7 @@ def score(job: tuple) -> tuple[str, dict]:
     policy = load_policy(Path(run) / "policy.pt")
     if radius is not None:
         policy = CriticGuidedPolicy(policy, load_critic(Path(run)), radius)
-    rows = [evaluate(policy, "lbgp", [s], robot="jackal", episodes=episodes, seed=scenario_seed(seed, s), obs_noise=True)[0]
-            for s in scenarios]
-    per_scenario = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
+    per_scenario = sim_table_rewards(policy, "lbgp", scenarios, episodes, seed)
     return name, {"run": str(run), "radius": radius, "per_scenario": per_scenario, "sum": round(float(sum(per_scenario.values())), 3)}
 
 

@@ -32,10 +32,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
-from ablation_scenarios import run_policies, scenario_seed  # noqa: E402
+from ablation_scenarios import run_policies, sim_table_rewards  # noqa: E402
 
 from lbgp.actions import goal_from_action  # noqa: E402
-from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
@@ -106,22 +105,19 @@ def score(job: tuple) -> tuple[str, str, dict]:
     run, policy_file, kind, value, scenarios, episodes, seed = job
     wrapper = SmoothedGoals if kind == "smoothing" else HeldGoals
     policy = wrapper(make_policy("lbgp", policy_file, robot="jackal"), value)
-    per_scenario = {name: round(float(evaluate(policy, "lbgp", [name], robot="jackal", episodes=episodes,
-                                               seed=scenario_seed(seed, name), obs_noise=True)[0]["reward"]), 3)
-                    for name in scenarios}
-    return run, acting_key(kind, value), per_scenario
+    return run, acting_key(kind, value), sim_table_rewards(policy, "lbgp", scenarios, episodes, seed)
 
 
 def summarise(runs: dict[str, dict[str, dict]], keys: list[str]) -> dict[str, dict]:
     """Per way of acting (``acting_key``): per-run sums, the paired difference of the sums to ``s = 0`` (mean, 95 % t
     half-width over the runs, separated or not) and each scenario's mean difference."""
     out = {}
+    scenarios = next(iter(runs.values()))["0"].keys()
     for key in keys:
         diffs = {run: sum(rows[key].values()) - sum(rows["0"].values()) for run, rows in runs.items()}
         values = list(diffs.values())
         half = reward_ci95(values) if len(values) > 1 else None
         mean = float(np.mean(values))
-        scenarios = next(iter(runs.values()))["0"].keys()
         out[key] = {
             "sums": {run: round(sum(rows[key].values()), 3) for run, rows in runs.items()},
             "minus_unsmoothed_paired": {"per_run": {r: round(d, 3) for r, d in diffs.items()}, "difference": round(mean, 3),

@@ -155,18 +155,25 @@ def test_train_set_changes_only_the_named_fields_over_the_preset(tmp_path):
     assert config["residual_scale"] == 0.0 and config["spawn_front_share"] == 0.5  # the rest: the paper's
 
 
-def test_train_set_takes_layer_sizes_and_target_updates(tmp_path, capsys):
+def test_train_set_takes_layer_sizes_target_updates_and_value_support(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--set", "hidden=32,16", "--set", "target_tau=0.01", "--set", "target_update_period=7",
+                 "--set", "num_atoms=11", "--set", "v_min=-12", "--set", "v_max=28",
                  "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
     config = json.loads((run / "config.json").read_text())
     assert config["hidden"] == [32, 16] and config["target_tau"] == 0.01 and config["target_update_period"] == 7
+    assert (config["num_atoms"], config["v_min"], config["v_max"]) == (11, -12.0, 28.0)
+    from lbgp.agent.checkpoint import load_checked
+    from lbgp.agent.train import CHECKPOINT_FORMAT
     from lbgp.agent.policy import load_policy
 
     layers = [m.out_features for m in load_policy(run / "policy.pt").actor.modules() if isinstance(m, torch.nn.Linear)]
     assert layers[:2] == [32, 16]  # the policy file's actor was built with the layers asked for
+    atoms = load_checked(run / "checkpoint.pt", CHECKPOINT_FORMAT)["learner"]["critic"]["atoms"]
+    assert torch.allclose(atoms, torch.linspace(-12.0, 28.0, 11))  # the critic's support is the one asked for
     for bad, words in (("hidden=32,none", "layer sizes"), ("hidden=0", "hidden"), ("target_tau=1.5", "target_tau"),
-                       ("target_update_period=0", "target_update_period")):
+                       ("target_update_period=0", "target_update_period"), ("num_atoms=1", "num_atoms"),
+                       ("v_min=nan", "finite"), ("v_max=-40", "v_min < v_max")):
         assert main(["train", "--set", bad, "--steps", "40", "--backend", "inline", "--out", str(tmp_path / "bad")]) == 2
         assert words in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()  # refused before anything is written

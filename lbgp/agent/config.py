@@ -134,8 +134,10 @@ class D4PGConfig:
             raise ValueError(f"method must be 'lbgp' or 'e2e', got {self.method!r}")
         if not 0 <= self.num_exploit <= self.num_actors or self.num_actors < 1:
             raise ValueError(f"need 1+ actors and at most that many exploiting ones, got {self.num_actors}/{self.num_exploit}")
-        if self.v_min >= self.v_max or self.num_atoms < 2:
-            raise ValueError("the value support needs v_min < v_max and at least 2 atoms")
+        if not (math.isfinite(self.v_min) and math.isfinite(self.v_max) and self.v_min < self.v_max):
+            raise ValueError(f"the value support needs finite v_min < v_max, got v_min={self.v_min}, v_max={self.v_max}")
+        if not 2 <= self.num_atoms <= 1001:
+            raise ValueError(f"num_atoms must be from 2 to 1001, got {self.num_atoms}")
         if self.randomize:
             from lbgp.dynamics import Randomization
 
@@ -184,7 +186,7 @@ class D4PGConfig:
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
                 "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction", "hidden",
-                "target_update_period", "target_tau")
+                "target_update_period", "target_tau", "num_atoms", "v_min", "v_max")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

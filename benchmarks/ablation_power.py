@@ -55,7 +55,10 @@ def variant_groups(files, variants=None) -> dict[str, dict]:
     groups: dict[str, dict] = {}
     seen: set[tuple] = set()
     for path in files:
-        data = json.loads(Path(path).read_text())
+        try:
+            data = json.loads(Path(path).read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{path}: not a readable JSON file ({exc})") from None
         if not (isinstance(data, dict) and isinstance(data.get("variants"), dict) and isinstance(data.get("runs"), dict)):
             continue
         for variant, info in sorted(data["variants"].items()):

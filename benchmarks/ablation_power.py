@@ -35,6 +35,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 from goal_ceiling import TRAJECTORIES, TURNING  # noqa: E402
 
+from lbgp.files import read_json  # noqa: E402
+
 import numpy as np  # noqa: E402
 from scipy import stats  # noqa: E402
 
@@ -55,10 +57,7 @@ def variant_groups(files, variants=None) -> dict[str, dict]:
     groups: dict[str, dict] = {}
     seen: set[tuple] = set()
     for path in files:
-        try:
-            data = json.loads(Path(path).read_text())
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{path}: not a readable JSON file ({exc})") from None
+        data = read_json(path, "ablation_scenarios results")
         if not (isinstance(data, dict) and isinstance(data.get("variants"), dict) and isinstance(data.get("runs"), dict)):
             continue
         for variant, info in sorted(data["variants"].items()):

@@ -71,4 +71,4 @@ def test_bad_differences_and_an_empty_folder_are_refused(tmp_path, capsys):
     (tmp_path / "broken.json").write_text('{"variants": ')  # a truncated file is named, not a traceback
     with pytest.raises(SystemExit) as exit_info:
         main(["--results", str(tmp_path)])
-    assert exit_info.value.code == 2 and "broken.json: not a readable JSON file" in capsys.readouterr().err
+    assert exit_info.value.code == 2 and "broken.json is not readable JSON" in capsys.readouterr().err

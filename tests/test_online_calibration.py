@@ -128,9 +128,12 @@ def test_load_calibration_online_and_bad_settings():
 @pytest.mark.parametrize("dynamics, slippery", [("hardware_like", True), ("nominal", False)])
 def test_the_simulated_jackal_feeds_the_estimator(dynamics, slippery):
     """The hardware-like Jackal turns about half as much as commanded (docs/simulation.md): the
-    estimate says so and the correction follows; the nominal one is left (almost) alone."""
+    estimate says so and the correction follows; the nominal one is left (almost) alone. 50 agent
+    steps (10 s): the turn commands must hold steady before a sample counts, and since the planner
+    lets the Jackal turn harder away from the person (2026-12-05) they are steady only late in the
+    35-step episode (the estimate is there, 0.38, the correction has made one 0.2 s step of its rate)."""
     cal = OnlineCalibration("jackal")
-    env = make_env("turning_outside", robot="jackal", seed=0, dynamics=dynamics, calibration=cal)
+    env = make_env("turning_outside", robot="jackal", seed=0, dynamics=dynamics, calibration=cal, horizon=50)
     run_episode(env, ConstantGoalPolicy())
     assert math.isfinite(cal.gains[1])
     if slippery:
@@ -194,7 +197,7 @@ def test_the_deploy_log_records_the_scale_each_command_was_sent_with(tmp_path):
     from lbgp.real.deploy import deploy
     from lbgp.real.replay import replay_log
 
-    loop = deploy(ConstantGoalPolicy((1.5, 0.0)), source="sim://turning_outside", robot="jackal", steps=35,
+    loop = deploy(ConstantGoalPolicy((1.5, 0.0)), source="sim://turning_outside", robot="jackal", steps=50,
                   log=tmp_path / "run.mcap", dynamics="hardware_like", calibration="online")
     _, log = replay_log(tmp_path / "run.mcap")
     statuses = [json.loads(message.data) for _, message in log["/lbgp/status"]]

@@ -261,6 +261,23 @@ def test_a_goal_just_behind_a_robot_moving_with_the_person_slows_it_down_instead
     assert np.all(np.abs(np.diff(plan.poses[:, 2])) < 0.05)  # the band does not turn around
 
 
+def test_the_jackal_turns_harder_at_speed_only_away_from_the_person():
+    """The lateral acceleration |v w| may reach lateral_acc_limit_clear (2 m/s^2) in free space but
+    only lateral_acc_limit (1 m/s^2) at the safety distance from the person; without the clear limit
+    it is 1 m/s^2 everywhere. The robot runs at 1.4 m/s, turning left, towards a goal on its left."""
+    cfg = JACKAL_PLANNER
+    assert cfg.lateral_acc_limit_clear > cfg.lateral_acc_limit
+    start, velocity, goal = [0.0, 0.0, 0.0], (1.4, 0.6), (2.0, 2.0, 1.57)
+    person_near = [0.0, -cfg.safety_distance, 0.0]  # beside the robot, on the side away from the goal
+    free = TebPlanner(cfg).plan(start, velocity, goal, FAR, (0.0, 0.0))
+    near = TebPlanner(cfg).plan(start, velocity, goal, person_near, (0.0, 0.0))
+    gentle = TebPlanner(cfg.with_(lateral_acc_limit_clear=None)).plan(start, velocity, goal, FAR, (0.0, 0.0))
+    assert free.ok and near.ok and gentle.ok
+    assert cfg.lateral_acc_limit + 0.2 < abs(free.v * free.w) <= cfg.lateral_acc_limit_clear + 1e-9
+    assert abs(near.v * near.w) <= cfg.lateral_acc_limit + 1e-9
+    assert abs(gentle.v * gentle.w) <= cfg.lateral_acc_limit + 1e-9
+
+
 def test_constant_goal_reward_is_smooth_in_the_goal_and_never_loops():
     """A quick version of benchmarks/goal_sweep.py (Jackal, goals 1.3-1.7 m straight ahead)."""
     import sys

@@ -24,7 +24,10 @@ class PlannerConfig:
     max_vel_theta: float = 2.0  # rad/s
     acc_lim_x: float = 1.5  # m/s^2
     acc_lim_theta: float = 3.0  # rad/s^2
-    lateral_acc_limit: float = 1.0  # m/s^2: |v w| at most this (turn gently at speed; a skid-steer base slips less then)
+    lateral_acc_limit: float = 1.0  # m/s^2: |v w| at most this (turn gently at speed; a skid-steer base slips less then) ...
+    lateral_acc_limit_clear: float | None = None  # m/s^2: ... near the person; where a band pose is lateral_acc_ramp or
+    # more beyond the safety distance from the person's predicted position, at most this (None: lateral_acc_limit everywhere)
+    lateral_acc_ramp: float = 0.5  # m over which the limit rises linearly from lateral_acc_limit to lateral_acc_limit_clear
     footprint_radius: float = 0.27  # m
     person_radius: float = PERSON_RADIUS
     safety_margin: float = 0.08  # m, clearance kept between footprint and person
@@ -82,6 +85,7 @@ JACKAL_PLANNER = PlannerConfig(
     max_vel_theta=2.0,
     acc_lim_x=1.5,
     acc_lim_theta=3.0,
+    lateral_acc_limit_clear=2.0,  # E2E's command range (1 m/s x 2 rad/s) allows as much; near the person 1.0 (docs/planner.md)
     footprint_radius=JACKAL.footprint_radius,
 )
 

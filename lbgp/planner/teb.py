@@ -452,7 +452,7 @@ class TebPlanner:
         moves more than ``step_tolerance`` in an iteration."""
         cfg = self.cfg
         floor = abs(problem.w_ref) - self._braking_w  # the turn-rate cap never below this (see _bounds)
-        u, lo, hi = self._clipped(u, lower, floor)
+        u, lo, hi = self._clipped(problem, u, lower, floor)
         done = 0
         for done in range(1, cfg.sqp_iterations + 1):
             if done > 1 and self._over_budget(t_start, spent_iterations + done - 1):
@@ -461,29 +461,44 @@ class TebPlanner:
             step, status = self._sqp_step(problem, u, lo, hi)
             if status != OK:
                 return u, status, done
-            u, lo, hi = self._clipped(u + step, lower, floor)
+            u, lo, hi = self._clipped(problem, u + step, lower, floor)
             if not np.all(np.isfinite(u)):
                 return u, DIVERGED, done
             if float(np.max(np.abs(step))) < cfg.step_tolerance:
                 break
         return u, OK, done
 
-    def _clipped(self, u: np.ndarray, lower: np.ndarray, floor: np.ndarray):
+    def _clipped(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, floor: np.ndarray):
         """``u`` clipped to its command bounds, and the bounds at the clipped commands (the same
-        bounds unless clipping changed a v: the turn-rate cap depends on v only)."""
+        bounds unless clipping changed a v: the turn-rate cap depends on v and on the band only)."""
         M = self.M
-        lo, hi = self._bounds(u, lower, floor)
+        lo, hi = self._bounds(problem, u, lower, floor)
         clipped = np.clip(u, lo, hi)
         if not np.array_equal(clipped[:M], u[:M]):
-            lo, hi = self._bounds(clipped, lower, floor)
+            lo, hi = self._bounds(problem, clipped, lower, floor)
         return clipped, lo, hi
 
-    def _bounds(self, u: np.ndarray, lower: np.ndarray, floor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Command bounds: the velocity limits, and |w| <= lateral_acc_limit / |v| (evaluated at the
-        current v; a fast robot turns gently), never tighter than ``floor``, what the angular
-        acceleration limit lets the robot reach from its current turn rate."""
+    def _lateral_limit(self, problem: _Problem, u: np.ndarray):
+        """The lateral acceleration |v w| each segment may reach: ``lateral_acc_limit``, or where
+        ``lateral_acc_limit_clear`` is set, rising linearly from it (the segment's start pose at the
+        safety distance from the person's predicted position) to ``lateral_acc_limit_clear`` (at
+        ``lateral_acc_ramp`` beyond it). A skid-steer base that turns hard at speed slips off its
+        band; away from the person that costs tracking, near the person it could cost clearance."""
+        cfg = self.cfg
+        if cfg.lateral_acc_limit_clear is None:
+            return cfg.lateral_acc_limit
+        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
+        clearance = np.hypot(*(poses[:-1, :2] - problem.person_path[:-1]).T)
+        share = np.clip((clearance - cfg.safety_distance) / cfg.lateral_acc_ramp, 0.0, 1.0)
+        return cfg.lateral_acc_limit + (cfg.lateral_acc_limit_clear - cfg.lateral_acc_limit) * share
+
+    def _bounds(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, floor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Command bounds: the velocity limits, and |w| <= the lateral acceleration limit / |v|
+        (``_lateral_limit``, evaluated at the current v and band; a fast robot turns gently), never
+        tighter than ``floor``, what the angular acceleration limit lets the robot reach from its
+        current turn rate."""
         cfg, M = self.cfg, self.M
-        cap = np.minimum(cfg.max_vel_theta, cfg.lateral_acc_limit / np.maximum(np.abs(u[:M]), 1e-6))
+        cap = np.minimum(cfg.max_vel_theta, self._lateral_limit(problem, u) / np.maximum(np.abs(u[:M]), 1e-6))
         np.maximum(cap, floor, out=cap)
         lo, hi = lower.copy(), self._u_hi.copy()
         np.maximum(lo[M:], -cap, out=lo[M:])

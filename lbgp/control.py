@@ -62,8 +62,9 @@ class GoalController:
 
     kind = "goal"
 
-    def __init__(self, planner: TebPlanner, prediction=None):
+    def __init__(self, planner: TebPlanner, prediction=None, calibration=None):
         self.planner = planner
+        self.calibration = calibration  # the command calibration after it (lbgp.calibration): the planner's turn limit is on what is sent
         self.prediction = prediction  # lbgp.drive_model.DrivePrediction: plan from the state when the command acts
         self.goal_person = np.array(DESIRED_GOAL)
 
@@ -86,6 +87,7 @@ class GoalController:
         plan = self.planner.plan(
             seen.robot_pose, seen.robot_velocity, goal, seen.person_pose, seen.person_velocity,
             person_turn_rate=seen.person_turn_rate, goal_moves_with_person=True,
+            command_scale_w=1.0 if self.calibration is None else float(self.calibration.scale_w),
         )
         self.sent(state.t, plan.v, plan.w)
         return Command(plan.v, plan.w, plan.status, goal, plan)

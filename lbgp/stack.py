@@ -29,15 +29,18 @@ def planner_limits(robot: str | RobotSpec, planner_period: float = PLANNER_PERIO
     return dataclasses.replace(base, control_period=float(planner_period), sqp_time_budget=budget)
 
 
-def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None):
+def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None, calibration=None):
     """``goal``: the policy's goal goes through the planner (LBGP, HC); ``velocity``: the policy's
     (v, w) is clamped to the limits (E2E). ``drive_model`` (``lbgp.drive_model``): the planner keeps
     within the drive's acceleration limits and plans from the state predicted one latency ahead;
-    a velocity policy's commands are its own and pass unchanged."""
+    a velocity policy's commands are its own and pass unchanged. ``calibration`` (``lbgp.calibration``,
+    ``lbgp.online_calibration``): the scaling the commands get after the controller; the planner
+    reads its current turn scale at every call."""
     if control == "goal":
         if drive_model is None:
-            return GoalController(TebPlanner(limits))
-        return GoalController(TebPlanner(within_drive_limits(limits, drive_model)), prediction=DrivePrediction(drive_model))
+            return GoalController(TebPlanner(limits), calibration=calibration)
+        return GoalController(TebPlanner(within_drive_limits(limits, drive_model)), prediction=DrivePrediction(drive_model),
+                              calibration=calibration)
     if control == "velocity":
         return VelocityController(limits)
     raise ValueError(f"unknown control mode {control!r}; use 'goal' or 'velocity'")

@@ -278,6 +278,50 @@ def test_the_jackal_turns_harder_at_speed_only_away_from_the_person():
     assert abs(gentle.v * gentle.w) <= cfg.lateral_acc_limit + 1e-9
 
 
+def test_the_turn_limit_clear_of_the_person_bounds_the_command_a_calibration_sends():
+    """A command calibration that doubles the turn rate on its way to the wheels (a base that turns
+    half as much as told) halves what the band may use of lateral_acc_limit_clear, never below
+    lateral_acc_limit; the controller passes the calibration's current scale to every call; a
+    scale that is not a positive number is bad input (a safe stop)."""
+    from lbgp import stack
+    from lbgp.calibration import CommandCalibration
+    from lbgp.planner import INVALID_INPUT
+    from lbgp.world import WorldState
+
+    cfg = JACKAL_PLANNER
+    start, velocity, goal = [0.0, 0.0, 0.0], (1.4, 0.6), (2.0, 2.0, 1.57)
+    halved = TebPlanner(cfg).plan(start, velocity, goal, FAR, (0.0, 0.0), command_scale_w=2.0)
+    assert halved.ok and abs(halved.v * halved.w) <= max(cfg.lateral_acc_limit, cfg.lateral_acc_limit_clear / 2.0) + 1e-9
+    for bad in (0.0, -1.0, float("nan")):
+        assert TebPlanner(cfg).plan(start, velocity, goal, FAR, (0.0, 0.0), command_scale_w=bad).status == INVALID_INPUT
+    # through the controller: the person 3 m to the left walking along x, the goal 1.5 m ahead of them
+    state = WorldState(0.0, np.array([0.0, 0.0, 0.0]), np.array([1.4, 0.6]), np.array([0.0, 3.0, 0.0]), np.array([0.5, 0.0]))
+    limits = stack.planner_limits("jackal")
+    plain = stack.make_controller("goal", limits).command(state)
+    scaled = stack.make_controller("goal", limits, calibration=CommandCalibration(1.0, 2.0)).command(state)
+    assert abs(plain.v * plain.w) > cfg.lateral_acc_limit + 0.2
+    assert abs(scaled.v * scaled.w) <= cfg.lateral_acc_limit + 1e-9
+    # the simulator and the deploy loop hand their calibration (an online one changes as it learns) to the planner
+    from lbgp.online_calibration import OnlineCalibration
+    from lbgp.real.deploy import deploy
+    from lbgp.sim import make_env
+
+    online = OnlineCalibration("jackal")
+    assert make_env("turning_outside", robot="jackal", seed=0, calibration=online).task.controller.calibration is online
+    loop = deploy(_Goal(), source="sim://turning_outside", robot="jackal", steps=1, calibration=online)
+    assert loop.controller.calibration is online
+
+
+class _Goal:
+    control = "goal"
+
+    def reset(self):
+        pass
+
+    def act(self, observation):
+        return np.zeros(2, dtype=np.float32)
+
+
 def test_constant_goal_reward_is_smooth_in_the_goal_and_never_loops():
     """A quick version of benchmarks/goal_sweep.py (Jackal, goals 1.3-1.7 m straight ahead)."""
     import sys

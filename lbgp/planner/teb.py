@@ -114,6 +114,7 @@ class _Problem:
     goal_path: np.ndarray  # (M, 2) goal position at each pose's time
     goal_yaw: np.ndarray  # (M,) the goal's heading at each pose's time
     person_path: np.ndarray  # (N, 2) predicted person position at each pose's time, from now
+    lateral_clear: float | None = None  # the lateral acceleration limit clear of the person, this call (``_lateral_limit``)
 
 
 class TebPlanner:
@@ -140,7 +141,7 @@ class TebPlanner:
         self._qp.reset()
 
     def plan(self, robot_pose, robot_velocity, goal, person_pose, person_velocity, goal_velocity=(0.0, 0.0),
-             person_turn_rate: float = 0.0, goal_moves_with_person: bool = False) -> Plan:
+             person_turn_rate: float = 0.0, goal_moves_with_person: bool = False, command_scale_w: float = 1.0) -> Plan:
         """One planner call.
 
         ``goal`` is (x, y) or (x, y, yaw) in the world now; its yaw defaults to the person's
@@ -148,7 +149,10 @@ class TebPlanner:
         (vx, vy) turning at ``person_turn_rate`` (rad/s). Every band pose tracks where the goal will
         be at that pose's time: with ``goal_moves_with_person`` the goal is fixed in the person's
         frame and rides the person's arc (what a follow-ahead goal does); otherwise it moves at
-        ``goal_velocity`` ((0, 0): a fixed goal, stop there).
+        ``goal_velocity`` ((0, 0): a fixed goal, stop there). ``command_scale_w``: what a command
+        calibration will multiply the turn rate by on its way to the wheels (``lbgp.calibration``);
+        ``lateral_acc_limit_clear`` bounds the command sent, so the band may use at most that
+        limit over this scale (never less than ``lateral_acc_limit``).
         Never raises on bad numbers: returns a safe-stop plan whose status says why.
         """
         t_start = time.perf_counter()
@@ -164,10 +168,11 @@ class TebPlanner:
             goal = goal.reshape(3)
             goal_vel = np.asarray(goal_velocity, dtype=float).reshape(2)
             turn = float(person_turn_rate)
+            scale_w = float(command_scale_w)
         except (TypeError, ValueError):
             return self._stop(0.0, 0.0, INVALID_INPUT, t_start)
-        values = np.concatenate([robot_pose, [v_now, w_now, turn], goal_vel, person_pose, person_vel, goal])
-        if not np.all(np.isfinite(values)):
+        values = np.concatenate([robot_pose, [v_now, w_now, turn, scale_w], goal_vel, person_pose, person_vel, goal])
+        if not np.all(np.isfinite(values)) or not scale_w > 0:
             return self._stop(v_now, w_now, INVALID_INPUT, t_start)
         if np.linalg.norm(goal[:2] - person_pose[:2]) < cfg.safety_distance:
             return self._stop(v_now, w_now, GOAL_IN_COLLISION, t_start)
@@ -189,6 +194,8 @@ class TebPlanner:
             goal_path=goal_path,
             goal_yaw=goal_yaw,
             person_path=person_path,
+            lateral_clear=None if cfg.lateral_acc_limit_clear is None else
+            max(cfg.lateral_acc_limit, cfg.lateral_acc_limit_clear / scale_w),
         )
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_off_heading(problem):
@@ -481,16 +488,17 @@ class TebPlanner:
     def _lateral_limit(self, problem: _Problem, u: np.ndarray):
         """The lateral acceleration |v w| each segment may reach: ``lateral_acc_limit``, or where
         ``lateral_acc_limit_clear`` is set, rising linearly from it (the segment's start pose at the
-        safety distance from the person's predicted position) to ``lateral_acc_limit_clear`` (at
-        ``lateral_acc_ramp`` beyond it). A skid-steer base that turns hard at speed slips off its
-        band; away from the person that costs tracking, near the person it could cost clearance."""
+        safety distance from the person's predicted position) to ``lateral_acc_limit_clear`` over
+        the command calibration's turn scale (at ``lateral_acc_ramp`` beyond it; ``plan``'s
+        ``command_scale_w``). A skid-steer base that turns hard at speed slips off its band; away
+        from the person that costs tracking, near the person it could cost clearance."""
         cfg = self.cfg
-        if cfg.lateral_acc_limit_clear is None:
+        if problem.lateral_clear is None:
             return cfg.lateral_acc_limit
         poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
         clearance = np.hypot(*(poses[:-1, :2] - problem.person_path[:-1]).T)
         share = np.clip((clearance - cfg.safety_distance) / cfg.lateral_acc_ramp, 0.0, 1.0)
-        return cfg.lateral_acc_limit + (cfg.lateral_acc_limit_clear - cfg.lateral_acc_limit) * share
+        return cfg.lateral_acc_limit + (problem.lateral_clear - cfg.lateral_acc_limit) * share
 
     def _bounds(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, floor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Command bounds: the velocity limits, and |w| <= the lateral acceleration limit / |v|

@@ -305,7 +305,7 @@ class FollowAheadTask(control.Task):
         self.limits = stack.planner_limits(spec, planner_period, planner_config)
         # the planner's model of the drive (lbgp.drive_model): None, it assumes the ideal drive
         self.drive_model = load_drive_model(drive_model, spec.name)
-        self.controller = stack.make_controller(control_mode, self.limits, self.drive_model)
+        self.controller = stack.make_controller(control_mode, self.limits, self.drive_model, self.calibration)
         self.control_mode = control_mode
         noise_on = setting.noise if obs_noise is None else obs_noise
         self.stack = obs_lib.ObservationStack(noise_std=noise_std if noise_on else None)

@@ -11,7 +11,9 @@ down for seed 2).
 
 Measured (`python benchmarks/learning_seeds.py --seeds 0,1,2,3`, results/learning_seeds.json;
 straight_ahead return, 35 steps, as judged here; the paper's plain actor with the goal prior,
-`D4PGConfig.paper(prior_weight=1)`; with the planner's SQP cap of 3, 2026-12-03): trained 23.0 /
+`D4PGConfig.paper(prior_weight=1)`; with the Jackal's lateral acceleration ramp, 2026-12-05: trained
+24.9 / 26.0 / 25.8 / 25.4 for seeds 0-3, untrained -0.5 / 9.3 / 4.3 / 2.8, random policy 1.7; with
+the planner's SQP cap of 3, 2026-12-03): trained 23.0 /
 23.6 / 25.9 / 24.1 for seeds 0-3, untrained -0.5 / 9.3 / 4.3 / 2.8, random policy 3.8 (with the cap
 of 5 and the QP refinement, 2026-12-02: 25.0 / 25.7 / 25.9 / 24.4, -0.8 / 9.2 / 4.4 / 2.8, 3.7;
 before the refinement: 23.8 / 24.4 / 24.4 / 24.0, -0.8 / 9.2 / 4.3 / 2.8, 1.0): the bounds below

@@ -304,22 +304,13 @@ def test_the_turn_limit_clear_of_the_person_bounds_the_command_a_calibration_sen
     # the simulator and the deploy loop hand their calibration (an online one changes as it learns) to the planner
     from lbgp.online_calibration import OnlineCalibration
     from lbgp.real.deploy import deploy
+    from lbgp.rollout import ConstantGoalPolicy
     from lbgp.sim import make_env
 
     online = OnlineCalibration("jackal")
     assert make_env("turning_outside", robot="jackal", seed=0, calibration=online).task.controller.calibration is online
-    loop = deploy(_Goal(), source="sim://turning_outside", robot="jackal", steps=1, calibration=online)
+    loop = deploy(ConstantGoalPolicy(), source="sim://turning_outside", robot="jackal", steps=1, calibration=online)
     assert loop.controller.calibration is online
-
-
-class _Goal:
-    control = "goal"
-
-    def reset(self):
-        pass
-
-    def act(self, observation):
-        return np.zeros(2, dtype=np.float32)
 
 
 def test_constant_goal_reward_is_smooth_in_the_goal_and_never_loops():

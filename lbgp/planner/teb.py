@@ -490,8 +490,9 @@ class TebPlanner:
         ``lateral_acc_limit_clear`` is set, rising linearly from it (the segment's start pose at the
         safety distance from the person's predicted position) to ``lateral_acc_limit_clear`` over
         the command calibration's turn scale (at ``lateral_acc_ramp`` beyond it; ``plan``'s
-        ``command_scale_w``). A skid-steer base that turns hard at speed slips off its band; away
-        from the person that costs tracking, near the person it could cost clearance."""
+        ``command_scale_w``). Near the person a hard turn at speed that the base does not follow
+        could cost clearance (measured: a flat 2 m/s^2 let HC come within 0.5 m of the person on
+        straight_behind, docs/planner.md, "Turning at speed")."""
         cfg = self.cfg
         if problem.lateral_clear is None:
             return cfg.lateral_acc_limit

@@ -124,7 +124,8 @@ def cmd_train(args) -> int:
         given = {"method": args.method, "robot": args.robot, "seed": args.seed,  # None: the config's default
                  "num_actors": args.actors, "prior_weight": args.prior_weight, "turn_lead": args.turn_lead, "max_updates_per_step": args.updates_per_step,
                  "mirror_augment": True if args.mirror_augment else None, "motion_features": True if args.motion_features else None,
-                 "previous_goal": True if args.previous_goal else None, "policy_average": args.policy_average}
+                 "previous_goal": True if args.previous_goal else None, "policy_average": args.policy_average,
+                 "init_policy": str(args.init_policy) if args.init_policy else None}
         if args.randomize:
             from lbgp.dynamics import load_randomization
 
@@ -397,6 +398,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--policy-average", type=A.fraction, default=None, metavar="TAU",
                    help="the policy file holds a moving average of the actor's weights, moved TAU toward it per update "
                         "(e.g. 1e-4; default 0: the last actor); the last actor is kept as policy_last.pt")
+    p.add_argument("--init-policy", type=A.input_file, default=None, metavar="FILE",
+                   help="start the actor from this policy file (fine-tuning: its weights and input standardisation; "
+                        "the critic starts fresh); the file must fit the run's configuration")
     p.add_argument("--set", type=training_setting, action="append", metavar="NAME=VALUE",
                    help="change one training-config field that has no option of its own, over the preset "
                         "(repeatable; e.g. spawn_front_share=0.5, noise_correlation=0, sigma=0.3; "

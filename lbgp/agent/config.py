@@ -115,6 +115,9 @@ class D4PGConfig:
     # 0.5 = uniform all around (the paper). Evaluation always uses the uniform spawn. Over 3 seeds uniform
     # spawns trailed by 3.2 +- 6.1 on the paper scenarios (not separated; docs/ablations.md)
 
+    init_policy: str = ""  # a policy file whose actor (weights and input standardisation) starts the run
+    # (fine-tuning, lbgp.agent.fine_tune; `lbgp train --init-policy FILE`); "": a freshly initialised actor
+
     # --- curriculum (see lbgp/agent/curriculum.py)
     level_thresholds: tuple = (15.0, 12.0, 8.0)  # exploit return (mean over the window) to advance
     level_budget_fraction: tuple = (0.15, 0.2, 0.25)  # ... or after this share of total_steps (and of

@@ -52,6 +52,7 @@ class D4PGLearner:
         self.prior = torch.as_tensor(action_from_goal(DESIRED_GOAL), dtype=torch.float32)
         self.prior_weight = cfg.prior_weight if cfg.method == "lbgp" else 0.0
         self.obs_stats_set = not cfg.normalize_obs  # nothing to set when inputs are not standardised
+        self.actor_stats_fixed = False  # the actors' standardisation came with them (lbgp.agent.fine_tune): keep it
 
     def set_obs_stats(self, observations) -> None:
         """Fix the input standardisation of all four networks from a sample of observations
@@ -62,7 +63,7 @@ class D4PGLearner:
             actor_in = self.actor.inputs(stored[:, : self.actor_inputs])
             critic_in = self.critic.inputs(stored)
         for net in (self.actor, self.target_actor, self.average_actor):
-            if net is not None:
+            if net is not None and not self.actor_stats_fixed:
                 net.set_obs_stats(actor_in.mean(0), actor_in.std(0))
         for net in (self.critic, self.target_critic):
             net.set_obs_stats(critic_in.mean(0), critic_in.std(0))
@@ -127,6 +128,7 @@ class D4PGLearner:
             "critic_opt": self.critic_opt.state_dict(),
             "updates": torch.tensor(self.updates),
             "obs_stats_set": torch.tensor(self.obs_stats_set),
+            "actor_stats_fixed": torch.tensor(self.actor_stats_fixed),
             **({"average_actor": self.average_actor.state_dict()} if self.average_actor is not None else {}),
         }
 
@@ -139,6 +141,7 @@ class D4PGLearner:
         self.critic_opt.load_state_dict(state["critic_opt"])
         self.updates = int(state["updates"])
         self.obs_stats_set = bool(state.get("obs_stats_set", True))
+        self.actor_stats_fixed = bool(state.get("actor_stats_fixed", False))
         if self.average_actor is not None:
             self.average_actor.load_state_dict(state["average_actor"] if "average_actor" in state else state["actor"])
 

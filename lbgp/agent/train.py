@@ -38,6 +38,7 @@ from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.files import atomic_file, write_json
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.curriculum import Curriculum
+from lbgp.agent.fine_tune import start_from_policy
 from lbgp.agent.learner import D4PGLearner
 from lbgp.agent.policy import save_policy
 from lbgp.agent.previous_goal import agent_input_size
@@ -115,6 +116,8 @@ class Trainer:
         torch.manual_seed(cfg.seed)
         self.rng = np.random.default_rng(cfg.seed)
         self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
+        if cfg.init_policy and not resume:  # before anything is written: a policy that does not fit leaves no run behind
+            start_from_policy(self.learner, cfg.init_policy, cfg)
         if cfg.priority_exponent > 0:
             self.replay = PrioritizedReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2,
                                                   cfg.priority_exponent, cfg.priority_correction)
@@ -344,6 +347,8 @@ class Trainer:
             "final_exploit_return_mean_last20": float(np.mean(final_level)) if final_level else None,
             "interrupted": interrupted,
         }
+        if cfg.init_policy:
+            summary["init_policy"] = cfg.init_policy  # the actor started as this file's (lbgp.agent.fine_tune)
         if self.learner.average_actor is not None:  # the last raw actor too, beside the average
             summary["policy_average"] = cfg.policy_average
             self._save_policy(self.dir / "policy_last.pt", self.learner.actor, {**summary, "policy_average": 0.0})

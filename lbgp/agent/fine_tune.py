@@ -31,9 +31,11 @@ def initial_actor_mismatch(policy_actor, cfg: D4PGConfig, obs_size: int, method:
         return f"motion_features {policy_actor.inputs.motion_features} in the policy, {wanted.inputs.motion_features} in the run"
     theirs = {k: tuple(v.shape) for k, v in policy_actor.state_dict().items()}
     ours = {k: tuple(v.shape) for k, v in wanted.state_dict().items()}
-    if theirs != ours:
-        return (f"the actor's layers differ (hidden sizes or inputs: the policy has "
-                f"{sorted(theirs.items())[:4]}..., the run {sorted(ours.items())[:4]}...)")
+    differing = [k for k in sorted(theirs.keys() | ours.keys()) if theirs.get(k) != ours.get(k)]
+    if differing:
+        k = differing[0]
+        return (f"the actor's layers differ (hidden sizes or inputs): {k} is {theirs.get(k, 'absent')} in the policy, "
+                f"{ours.get(k, 'absent')} in the run ({len(differing)} tensors differ)")
     return ""
 
 

@@ -39,16 +39,12 @@ def initial_actor_mismatch(policy_actor, cfg: D4PGConfig, obs_size: int, method:
     return ""
 
 
-def start_from_policy(learner: D4PGLearner, path: str | Path, cfg: D4PGConfig) -> None:
+def start_from_policy(learner: D4PGLearner, path: str | Path) -> None:
     """Load the actor of the policy file at ``path`` into ``learner`` (actor, target, average) and
-    keep its input standardisation. A corrupt file or one whose actor does not fit ``cfg`` raises a
-    ValueError naming the problem."""
+    keep its input standardisation. A corrupt file or one whose actor does not fit the learner's
+    configuration raises a ValueError naming the problem."""
     policy = load_policy(path)
-    problem = initial_actor_mismatch(policy.actor, cfg, learner.actor_inputs, policy.method)
+    problem = initial_actor_mismatch(policy.actor, learner.cfg, learner.actor_inputs, policy.method)
     if problem:
         raise ValueError(f"{path}: cannot start this run from that policy: {problem}")
-    state = policy.actor.state_dict()
-    for net in (learner.actor, learner.target_actor, learner.average_actor):
-        if net is not None:
-            net.load_state_dict(state)
-    learner.actor_stats_fixed = True
+    learner.start_actor_from(policy.actor.state_dict())

@@ -62,12 +62,23 @@ class D4PGLearner:
             stored = torch.as_tensor(observations, dtype=torch.float32)
             actor_in = self.actor.inputs(stored[:, : self.actor_inputs])
             critic_in = self.critic.inputs(stored)
-        for net in (self.actor, self.target_actor, self.average_actor):
-            if net is not None and not self.actor_stats_fixed:
-                net.set_obs_stats(actor_in.mean(0), actor_in.std(0))
+        for net in [] if self.actor_stats_fixed else self._actor_copies():
+            net.set_obs_stats(actor_in.mean(0), actor_in.std(0))
         for net in (self.critic, self.target_critic):
             net.set_obs_stats(critic_in.mean(0), critic_in.std(0))
         self.obs_stats_set = True
+
+    def _actor_copies(self) -> list[Actor]:
+        """The actor, its target and (with cfg.policy_average) its weight average."""
+        return [net for net in (self.actor, self.target_actor, self.average_actor) if net is not None]
+
+    def start_actor_from(self, actor_state: dict) -> None:
+        """Start the actor, its target and its average as a trained actor (``actor_state``, a state
+        dict of the actor this config builds), keeping that actor's input standardisation:
+        ``set_obs_stats`` then standardises the critic's inputs only (fine-tuning, lbgp.agent.fine_tune)."""
+        for net in self._actor_copies():
+            net.load_state_dict(actor_state)
+        self.actor_stats_fixed = True
 
     def update(self, batch: dict[str, torch.Tensor], actor_batch: dict[str, torch.Tensor] | None = None) -> dict[str, float]:
         """One critic and (after the warm-up) one actor step. A prioritised batch carries importance

@@ -117,7 +117,7 @@ class Trainer:
         self.rng = np.random.default_rng(cfg.seed)
         self.learner = D4PGLearner(cfg, agent_input_size(cfg.previous_goal), 2)
         if cfg.init_policy and not resume:  # before anything is written: a policy that does not fit leaves no run behind
-            start_from_policy(self.learner, cfg.init_policy, cfg)
+            start_from_policy(self.learner, cfg.init_policy)
         if cfg.priority_exponent > 0:
             self.replay = PrioritizedReplayBuffer(cfg.replay_capacity, self.learner.critic_inputs, 2,
                                                   cfg.priority_exponent, cfg.priority_correction)

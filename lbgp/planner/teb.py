@@ -476,8 +476,10 @@ class TebPlanner:
         return u, OK, done
 
     def _clipped(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, floor: np.ndarray):
-        """``u`` clipped to its command bounds, and the bounds at the clipped commands (the same
-        bounds unless clipping changed a v: the turn-rate cap depends on v and on the band only)."""
+        """``u`` clipped to its command bounds, and the bounds for the next step: recomputed at the
+        clipped commands where clipping changed a v (the turn-rate cap divides by v); where it changed
+        only a w, those of ``u``, whose band differs a little from the clipped one's (with
+        ``lateral_acc_limit_clear`` the cap also depends on the band's clearance from the person)."""
         M = self.M
         lo, hi = self._bounds(problem, u, lower, floor)
         clipped = np.clip(u, lo, hi)

@@ -145,6 +145,45 @@ def test_band_and_person_prediction_are_returned():
     assert np.linalg.norm(plan.poses[-1, :2] - [2, 0]) < 0.1
 
 
+class _RolloutEveryTime(TebPlanner):
+    """The planner without its kept band: every band is rolled out anew where it is asked for."""
+
+    def _band(self, problem, u):
+        self._last_band = None
+        return super()._band(problem, u)
+
+
+@pytest.mark.parametrize("robot", sorted(PRESETS))
+def test_the_kept_band_changes_no_plan(robot):
+    """TebPlanner._band keeps the last band it rolled out (the bounds, the QP and the score ask for
+    the band of the same commands): plans are exactly those of rolling every band out anew, near
+    the person too (where the Jackal's turn limit depends on the band's clearance), and with a
+    caller that writes each new state into the same arrays."""
+    cfg = PRESETS[robot]
+    rng = np.random.default_rng(3)
+    kept, anew = TebPlanner(cfg), _RolloutEveryTime(cfg)
+    pose, velocity, person = np.zeros(3), np.zeros(2), np.zeros(3)
+    for k in range(30):
+        if k % 2:  # following: the goal 1.5 m ahead of a person walking and turning nearby
+            pose[:] = [*rng.uniform(-0.5, 0.5, 2), rng.uniform(-np.pi, np.pi)]
+            velocity[:] = [rng.uniform(0.0, cfg.max_vel_x), rng.uniform(-1.0, 1.0)]
+            person[:] = [*(pose[:2] + rng.uniform(-1.5, 1.5, 2)), rng.uniform(-np.pi, np.pi)]
+            person_vel = 0.6 * np.array([np.cos(person[2]), np.sin(person[2])])
+            goal = person[:2] + 1.5 * np.array([np.cos(person[2]), np.sin(person[2])])
+        else:  # turning hard at speed beside a standing person (the turn limit ramps with clearance)
+            pose[:] = [0.0, 0.0, 0.0]
+            velocity[:] = [rng.uniform(0.7, 1.0) * cfg.max_vel_x, rng.uniform(0.3, 0.9)]
+            person[:] = [rng.uniform(-0.5, 0.5), -cfg.safety_distance - rng.uniform(0.0, 0.6), 0.0]
+            person_vel = np.zeros(2)
+            goal = np.array([2.0, 2.0, 1.57])
+        moving = bool(k % 2)
+        a = kept.plan(pose, velocity, goal, person, person_vel, person_turn_rate=0.3 * moving, goal_moves_with_person=moving)
+        b = anew.plan(pose.copy(), velocity.copy(), goal, person.copy(), person_vel, person_turn_rate=0.3 * moving,
+                      goal_moves_with_person=moving)
+        assert (a.status, a.v, a.w, a.candidate, a.iterations) == (b.status, b.v, b.w, b.candidate, b.iterations)
+        np.testing.assert_array_equal(a.poses, b.poses)
+
+
 def test_reset_makes_plans_reproducible():
     planner = TebPlanner(JACKAL_PLANNER)
     first = drive(planner, [0, 0, 0.3], np.array([2.0, 1.0, 0.0]), steps=10)[1]

@@ -128,6 +128,7 @@ class TebPlanner:
             raise ValueError(f"n_poses must be at least 3, got {N}")
         self.N, self.M = N, N - 1
         self.h = float(self.cfg.band_dt)
+        self._last_band = None  # (pose0, person path, commands, poses, distances): see _band
         self._setup_structure()
 
     @property
@@ -157,6 +158,7 @@ class TebPlanner:
         """
         t_start = time.perf_counter()
         cfg = self.cfg
+        self._last_band = None
         try:
             robot_pose = np.asarray(robot_pose, dtype=float).reshape(3)
             v_now, w_now = (float(x) for x in np.asarray(robot_velocity, dtype=float).reshape(2))
@@ -222,8 +224,8 @@ class TebPlanner:
                 if best is not None:
                     continue  # an extra candidate that failed is just not a candidate
                 return self._stop(v_now, w_now, status, t_start, None, problem, iterations)
-            poses = rollout(robot_pose, u[: self.M], u[self.M :], self.h)
-            clearance = self._clearance(problem, poses)
+            poses, distance = self._band(problem, u)
+            clearance = distance[1:]
             cost = self._candidate_score(problem, u, poses, clearance)
             if best is None or cost < best[0] - 1e-9:
                 best = (cost, u, name, poses, clearance)
@@ -311,11 +313,22 @@ class TebPlanner:
         lower[:M] = np.minimum(0.0, reachable)
         return lower
 
-    @staticmethod
-    def _clearance(problem: _Problem, poses: np.ndarray) -> np.ndarray:
-        """Distance of band poses 1..M from the person's predicted position at their times."""
-        diff = poses[1:, :2] - problem.person_path[1:]
-        return np.hypot(diff[:, 0], diff[:, 1])
+    def _band(self, problem: _Problem, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The band of the commands ``u``: its poses (N, 3) and each pose's distance from the
+        person's predicted position at its time (N,; the clearance of poses 1..M is ``[1:]``), both
+        read-only. The bounds, the QP and the band's score each ask for the band of the same
+        commands: the last one is kept (for the same start and person prediction; ``plan`` forgets
+        it at every call), so a band is rolled out once, not up to four times."""
+        key = u.tobytes()
+        cached = self._last_band
+        if cached is not None and cached[0] is problem.pose0 and cached[1] is problem.person_path and cached[2] == key:
+            return cached[3], cached[4]
+        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
+        diff = poses[:, :2] - problem.person_path
+        distance = np.hypot(diff[:, 0], diff[:, 1])
+        poses.flags.writeable = distance.flags.writeable = False
+        self._last_band = (problem.pose0, problem.person_path, key, poses, distance)
+        return poses, distance
 
     def _over_budget(self, t_start: float, iterations: int) -> bool:
         budget = self.cfg.sqp_time_budget
@@ -498,8 +511,7 @@ class TebPlanner:
         cfg = self.cfg
         if problem.lateral_clear is None:
             return cfg.lateral_acc_limit
-        poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
-        clearance = np.hypot(*(poses[:-1, :2] - problem.person_path[:-1]).T)
+        clearance = self._band(problem, u)[1][:-1]  # of each segment's start pose
         share = np.clip((clearance - cfg.safety_distance) / cfg.lateral_acc_ramp, 0.0, 1.0)
         return cfg.lateral_acc_limit + (problem.lateral_clear - cfg.lateral_acc_limit) * share
 
@@ -519,7 +531,8 @@ class TebPlanner:
     def _sqp_step(self, problem: _Problem, u: np.ndarray, lower: np.ndarray, upper: np.ndarray):
         cfg, M, h = self.cfg, self.M, self.h
         v, w = u[:M], u[M:]
-        poses = rollout(problem.pose0, v, w, h)
+        poses, distance = self._band(problem, u)
+        dist = distance[1:]
         phi = poses[:-1, 2] + 0.5 * h * w
         c, s = np.cos(phi), np.sin(phi)
         hv = h * v
@@ -528,7 +541,6 @@ class TebPlanner:
         Ax[self._kin_pos] = np.concatenate([
             -h * c, 0.5 * h * hv * s, -h * s, -0.5 * h * hv * c, hv[1:] * s[1:], -hv[1:] * c[1:],
         ])
-        dist = self._clearance(problem, poses)
         normal = (poses[1:, :2] - problem.person_path[1:]) / np.maximum(dist, 1e-9)[:, None]
         Ax[self._clear_pos] = normal.T.ravel()
         q = self._q

@@ -144,6 +144,16 @@ def _true_poses(env) -> tuple[np.ndarray, np.ndarray]:
     return info["robot_pose"], info["person_pose"]
 
 
+def training_planner(cfg: D4PGConfig):
+    """The planner configuration the actors' environments drive with: the robot's preset, with
+    ``planner_sqp_iterations`` where set (None: the environment's own default, the preset)."""
+    if not cfg.planner_sqp_iterations:
+        return None
+    from lbgp.planner import planner_config_for
+
+    return planner_config_for(cfg.robot).with_(sqp_iterations=cfg.planner_sqp_iterations)
+
+
 class EnvCache:
     """One environment per curriculum level, created on first use with a seed from ``rng``."""
 
@@ -157,6 +167,7 @@ class EnvCache:
             cfg = self.cfg
             self.envs[level] = make_env(level, robot=cfg.robot, seed=int(self.rng.integers(2**31)), control=cfg.control,
                                         horizon=cfg.horizon, spawn_front_share=cfg.spawn_front_share,
+                                        planner_config=training_planner(cfg),
                                         randomize=cfg.randomize or None,
                                         drawn_paths=cfg.drawn_paths and level == DRAWN_PATHS_LEVEL)
         return self.envs[level]

@@ -107,6 +107,9 @@ class D4PGConfig:
     drawn_paths: bool = False  # the trajectories level draws a fresh person path every episode
     # (lbgp.sim.tasks.drawn_paths_setting) instead of walking one of the library's 20
     # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/ablations.md)
+    planner_sqp_iterations: int = 0  # the planner's SQP iterations per band in training (0: the robot's
+    # preset, 3); 1 is a stateless real-time iteration, ~2x faster (docs/planner.md, "The SQP iteration
+    # cap"). The policy is then meant for that planner: evaluate it with the same cap.
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
     # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
     # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
@@ -180,6 +183,8 @@ class D4PGConfig:
             raise ValueError(f"hidden must be 1+ layer sizes from 1 to 4096, got {self.hidden}")
         if self.target_update_period < 1 or not 0.0 <= self.target_tau <= 1.0:
             raise ValueError(f"target_update_period must be >= 1 and target_tau in [0, 1], got {self.target_update_period}, {self.target_tau}")
+        if not 0 <= self.planner_sqp_iterations <= 50:
+            raise ValueError(f"planner_sqp_iterations must be from 0 (the preset) to 50, got {self.planner_sqp_iterations}")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -189,7 +194,7 @@ class D4PGConfig:
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
                 "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction", "hidden",
-                "target_update_period", "target_tau", "num_atoms", "v_min", "v_max")
+                "target_update_period", "target_tau", "num_atoms", "v_min", "v_max", "planner_sqp_iterations")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

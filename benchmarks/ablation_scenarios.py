@@ -28,6 +28,9 @@ the paired control from the same training, its difference given per seed.
 choice kept elsewhere are compared with the ablation's LBGP runs on the same episodes, e.g. mirror
 augmentation in training (docs/ablations.md):
 ``--runs results/ablation_runs,results/mirror_augment_runs --variants LBGP,LBGP-mirror-augment``.
+
+``--planner-sqp-iterations K`` scores every policy and HC on the planner with that SQP cap per band
+(runs trained with ``lbgp train --set planner_sqp_iterations=K``); E2E drives no planner.
 """
 
 from __future__ import annotations
@@ -177,6 +180,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--planner-sqp-iterations", type=int, default=0,
+                    help="score every planner-driven method (HC too) with this SQP cap per band (0: the preset; "
+                         "for runs trained with --set planner_sqp_iterations=K)")
     ap.add_argument("--deadbands", default=str(GOAL_DEADBAND_M), help="comma-separated goal dead bands (m) for the LBGP runs")
     ap.add_argument("--mirror", default="on" if MIRROR_AVERAGE else "off",
                     help="comma-separated on/off: score every run with and/or without mirror-averaged acting")
@@ -198,7 +204,10 @@ def main(argv: list[str] | None = None) -> dict:
     policies = run_policies(args.runs.split(","), args.variants.split(",") if args.variants else None)
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
-    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None)]
+    if not 0 <= args.planner_sqp_iterations <= 50:
+        ap.error(f"--planner-sqp-iterations must be from 0 (the preset) to 50, got {args.planner_sqp_iterations}")
+    planner = {"sqp_iterations": args.planner_sqp_iterations} if args.planner_sqp_iterations else {}
+    jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None, planner)]
     for name, path in policies.items():
         e2e = variant_of(name) == "E2E"
         files = {False: path}
@@ -208,13 +217,13 @@ def main(argv: list[str] | None = None) -> dict:
             for d in [None] if e2e else deadbands:
                 for m in mirrors:
                     jobs.append((acting_run_name(name, d, m, last), "e2e" if e2e else "lbgp", str(file), scenarios,
-                                 args.episodes, args.seed, d, m))
+                                 args.episodes, args.seed, d, m, planner))
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")
     result = {
         "command": command_line("ablation_scenarios.py", argv),
-        "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios,
+        "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "planner_changes": planner,
         "hc": hc, "variants": summarise(scored), "runs": scored,
     }
     write_result(args.json, result)

@@ -8,7 +8,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from ablation_scenarios import acting_run_name, main, summarise, variant_of  # noqa: E402
+from ablation_scenarios import acting_run_name, main, scenario_seed, summarise, variant_of  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
@@ -105,3 +105,26 @@ def test_last_actor_scores_a_policy_average_runs_last_actor_as_its_paired_contro
     assert last["sum"] != average["sum"]  # two different actors on the same episode
     paired = result["variants"]["LBGP-policy-average@last"]["minus_LBGP-policy-average_paired"]
     assert paired["per_seed"] == [pytest.approx(last["sum"] - average["sum"], abs=2e-3)]
+
+
+def test_a_planner_cap_scores_hc_and_the_policies_on_that_planner(tmp_path):
+    """--planner-sqp-iterations K: every planner-driven method faces the same episodes on the planner
+    with that SQP cap (as evaluate with the preset changed), and the file says so."""
+    from lbgp.planner import planner_config_for
+
+    runs = tmp_path / "runs"
+    (runs / "LBGP-cap1_s0").mkdir(parents=True)
+    shutil.copy(default_policy_path("lbgp"), runs / "LBGP-cap1_s0" / "policy.pt")
+    args = ["--runs", str(runs), "--scenarios", "turning_inside", "--episodes", "1"]
+    capped = main(args + ["--planner-sqp-iterations", "1", "--json", str(tmp_path / "cap1.json")])
+    preset = main(args + ["--json", str(tmp_path / "preset.json")])
+    cap1 = planner_config_for("jackal").with_(sqp_iterations=1)
+    (hc,) = evaluate(make_policy("hc"), "hc", ["turning_inside"], episodes=1, seed=scenario_seed(0, "turning_inside"), obs_noise=True,
+                   planner_config=cap1)
+    assert capped["planner_changes"] == {"sqp_iterations": 1} and preset["planner_changes"] == {}
+    assert capped["hc"]["sum"] == pytest.approx(hc["reward"], abs=1e-3)
+    assert capped["hc"]["sum"] != preset["hc"]["sum"]
+    assert capped["runs"]["LBGP-cap1_s0"]["sum"] != preset["runs"]["LBGP-cap1_s0"]["sum"]
+    with pytest.raises(SystemExit):
+        main(args + ["--planner-sqp-iterations", "-1", "--json", str(tmp_path / "bad.json")])
+    assert not (tmp_path / "bad.json").exists()

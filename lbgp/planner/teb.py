@@ -128,7 +128,7 @@ class TebPlanner:
             raise ValueError(f"n_poses must be at least 3, got {N}")
         self.N, self.M = N, N - 1
         self.h = float(self.cfg.band_dt)
-        self._last_band = None  # (pose0, person path, commands, poses, distances): see _band
+        self._last_band = None  # (commands, poses, distances) of this call's last band: see _band
         self._setup_structure()
 
     @property
@@ -317,17 +317,17 @@ class TebPlanner:
         """The band of the commands ``u``: its poses (N, 3) and each pose's distance from the
         person's predicted position at its time (N,; the clearance of poses 1..M is ``[1:]``), both
         read-only. The bounds, the QP and the band's score each ask for the band of the same
-        commands: the last one is kept (for the same start and person prediction; ``plan`` forgets
-        it at every call), so a band is rolled out once, not up to four times."""
+        commands: the last one is kept, keyed on the commands alone (every band of a call starts at
+        the same pose against the same person prediction; ``plan`` forgets it at every call), so a
+        band is rolled out once, not up to four times."""
         key = u.tobytes()
-        cached = self._last_band
-        if cached is not None and cached[0] is problem.pose0 and cached[1] is problem.person_path and cached[2] == key:
-            return cached[3], cached[4]
+        if self._last_band is not None and self._last_band[0] == key:
+            return self._last_band[1], self._last_band[2]
         poses = rollout(problem.pose0, u[: self.M], u[self.M :], self.h)
         diff = poses[:, :2] - problem.person_path
         distance = np.hypot(diff[:, 0], diff[:, 1])
         poses.flags.writeable = distance.flags.writeable = False
-        self._last_band = (problem.pose0, problem.person_path, key, poses, distance)
+        self._last_band = (key, poses, distance)
         return poses, distance
 
     def _over_budget(self, t_start: float, iterations: int) -> bool:

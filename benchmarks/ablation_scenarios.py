@@ -30,7 +30,9 @@ augmentation in training (docs/ablations.md):
 ``--runs results/ablation_runs,results/mirror_augment_runs --variants LBGP,LBGP-mirror-augment``.
 
 ``--planner-sqp-iterations K`` scores every policy and HC on the planner with that SQP cap per band
-(runs trained with ``lbgp train --set planner_sqp_iterations=K``); E2E drives no planner.
+(runs trained with ``lbgp train --set planner_sqp_iterations=K``); E2E drives no planner. Without it
+every method drives the preset, even a policy whose file names another planner (``lbgp evaluate``
+would honour the file), so that all are compared on one planner.
 """
 
 from __future__ import annotations
@@ -116,9 +118,10 @@ def sqp_cap(text: str) -> int:
 
 def score(job: tuple) -> tuple[str, dict]:
     """job: (name, method, policy_file, scenarios, episodes, seed, deadband, mirror[, planner_changes]);
-    ``planner_changes``: PlannerConfig fields to change from the Jackal's preset (default none)."""
+    ``planner_changes``: PlannerConfig fields to change from the Jackal's preset (default none). Every
+    method drives that planner, whatever planner a policy file says it was trained on."""
     name, method, policy_file, scenarios, episodes, seed, deadband, mirror, *rest = job
-    planner = planner_config_for("jackal").with_(**rest[0]) if rest and rest[0] else None
+    planner = planner_config_for("jackal", rest[0] if rest else None)
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
     per_scenario = sim_table_rewards(policy, method, scenarios, episodes, seed, planner)
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
@@ -213,7 +216,7 @@ def main(argv: list[str] | None = None) -> dict:
     policies = run_policies(args.runs.split(","), args.variants.split(",") if args.variants else None)
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
-    planner = {"sqp_iterations": args.planner_sqp_iterations} if args.planner_sqp_iterations else {}
+    planner = D4PGConfig(planner_sqp_iterations=args.planner_sqp_iterations).planner_changes()
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None, planner)]
     for name, path in policies.items():
         e2e = variant_of(name) == "E2E"

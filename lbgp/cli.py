@@ -29,6 +29,7 @@ def cmd_demo(args) -> int:
     from lbgp.rollout import ConstantGoalPolicy, run_episode
     from lbgp.sim import make_env
     from lbgp.sim.tasks import CURRICULUM
+    from lbgp.stack import policy_planner, policy_planner_note
     from lbgp.viz.recording import EpisodeRecorder
 
     out = Path(args.out)
@@ -44,10 +45,13 @@ def cmd_demo(args) -> int:
     else:
         policy, policy_name = ConstantGoalPolicy(), "scripted goal 1.5 m ahead of the person (no pretrained policy found)"
     print(f"lbgp demo: robot={args.robot} seed={args.seed} policy: {policy_name}")
+    if note := policy_planner_note(policy, args.robot):
+        print(note)
     rows = []
     with EpisodeRecorder(out / "demo.rrd") as recorder:
         for i, level in enumerate(CURRICULUM):
-            env = make_env(level, robot=args.robot, seed=args.seed + i, control=policy.control)
+            env = make_env(level, robot=args.robot, seed=args.seed + i, control=policy.control,
+                           planner_config=policy_planner(policy, args.robot))
             rows.append(run_episode(env, policy, recorder, episode_index=i).summary())
     _print_table(rows)
     summary = {"robot": args.robot, "seed": args.seed, "policy": policy_name, "episodes": rows}
@@ -58,12 +62,14 @@ def cmd_demo(args) -> int:
 
 def cmd_evaluate(args) -> int:
     from lbgp.evaluate import evaluate, resolve_names
-
     from lbgp.policies import make_policy
+    from lbgp.stack import policy_planner_note
 
     policy = make_policy(args.method, args.policy, args.hc_distance, args.hc_horizon, robot=args.robot, transfer=args.transfer,
                          goal_deadband=args.goal_deadband, mirror_average=False if args.no_mirror else None)
     names = resolve_names(args.scenario)
+    if note := policy_planner_note(policy, args.robot):
+        print(note)
     recorder = None
     if args.record or args.spawn:
         from lbgp.viz.recording import EpisodeRecorder
@@ -166,11 +172,14 @@ def cmd_deploy(args) -> int:
 
     from lbgp.policies import make_policy
     from lbgp.real.deploy import deploy
+    from lbgp.stack import policy_planner_note
 
     policy = make_policy(args.method, args.policy, robot=args.robot, transfer=args.transfer, goal_deadband=args.goal_deadband,
                          mirror_average=False if args.no_mirror else None)
     print(f"lbgp deploy: {args.method} policy, source {args.source}, sink {args.sink or 'default'}, robot {args.robot}"
           + (f", logging to {args.log}" if args.log else ""), flush=True)
+    if note := policy_planner_note(policy, args.robot):
+        print(f"lbgp deploy: {note}", flush=True)
     previous = _stop_on_signals()
     try:
         loop = deploy(policy, source=args.source, sink=args.sink, robot=args.robot, steps=args.steps, log=args.log,

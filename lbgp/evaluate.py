@@ -15,6 +15,7 @@ from lbgp.metrics import aggregate
 from lbgp.rollout import run_episode
 from lbgp.sim import make_env
 from lbgp.sim.tasks import LEVELS, SCENARIOS
+from lbgp.stack import policy_planner
 
 
 def resolve_names(spec: str) -> list[str]:
@@ -40,8 +41,10 @@ def evaluate(policy, method: str, names: list[str], robot: str = "jackal", episo
     online estimator (``lbgp.online_calibration``) for all the episodes, in order, as one robot
     doing every run keeps what it learned.
     ``drive_model``: the planner's model of the drive (``lbgp.drive_model``; default none).
-    ``planner_config``: the planner's ``PlannerConfig`` (default: the robot's preset)."""
+    ``planner_config``: the planner's ``PlannerConfig`` (default: the robot's preset with the changes
+    the policy was trained with, ``lbgp.stack.policy_planner``)."""
     calibration = load_calibration(calibration, robot)
+    planner_config = policy_planner(policy, robot, planner_config)
     results = []
     for k, name in enumerate(names):
         env = make_env(name, robot=robot, seed=seed + 1000 * k, control=policy.control, person_path=person_path,

@@ -29,6 +29,26 @@ def planner_limits(robot: str | RobotSpec, planner_period: float = PLANNER_PERIO
     return dataclasses.replace(base, control_period=float(planner_period), sqp_time_budget=budget)
 
 
+def policy_planner(policy, robot: str | RobotSpec, config: PlannerConfig | None = None) -> PlannerConfig | None:
+    """The planner configuration ``policy`` drives with: ``config`` where the caller names one, else
+    the robot's preset with the changes the policy was trained with (``Policy.planner_changes``);
+    None (the preset) for a policy that has none (HC, scripted, the shipped policies)."""
+    changes = getattr(policy, "planner_changes", None)
+    if config is not None or not changes:
+        return config
+    return planner_config_for(robot, changes)
+
+
+def policy_planner_note(policy, robot) -> str:
+    """One line saying which planner ``policy`` drives where it is not the preset ("" otherwise)."""
+    changes = getattr(policy, "planner_changes", None)
+    if not changes:
+        return ""
+    name = robot.name if isinstance(robot, RobotSpec) else robot
+    settings = ", ".join(f"{k}={v}" for k, v in changes.items())
+    return f"planner: the {name} preset with {settings} (the policy was trained on that planner)"
+
+
 def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None, calibration=None):
     """``goal``: the policy's goal goes through the planner (LBGP, HC); ``velocity``: the policy's
     (v, w) is clamped to the limits (E2E). ``drive_model`` (``lbgp.drive_model``): the planner keeps

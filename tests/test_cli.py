@@ -120,6 +120,20 @@ def test_train_previous_goal_flag_reaches_the_run_config_and_the_policy_file(tmp
     assert policy.previous_goal and policy.actor.obs_size == 59
 
 
+def test_a_policy_trained_on_another_planner_is_evaluated_and_shown_on_it(tmp_path, capsys):
+    from lbgp.agent.policy import load_policy
+
+    run = tmp_path / "run"
+    assert main(["train", "--set", "planner_sqp_iterations=1", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 0
+    assert load_policy(run / "policy.pt").planner_changes == {"sqp_iterations": 1}
+    capsys.readouterr()
+    assert main(["evaluate", "--method", "lbgp", "--policy", str(run / "policy.pt"), "--scenario", "straight_ahead",
+                 "--episodes", "1"]) == 0
+    assert "planner: the jackal preset with sqp_iterations=1" in capsys.readouterr().out
+    assert main(["evaluate", "--method", "lbgp", "--scenario", "straight_ahead", "--episodes", "1"]) == 0
+    assert "planner:" not in capsys.readouterr().out  # the shipped policy drives the preset
+
+
 def test_train_policy_average_reaches_the_run_config_and_writes_both_policies(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["train", "--policy-average", "1.5", "--steps", "40", "--backend", "inline", "--out", str(run)]) == 2

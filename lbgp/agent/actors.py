@@ -145,13 +145,11 @@ def _true_poses(env) -> tuple[np.ndarray, np.ndarray]:
 
 
 def training_planner(cfg: D4PGConfig):
-    """The planner configuration the actors' environments drive with: the robot's preset, with
-    ``planner_sqp_iterations`` where set (None: the environment's own default, the preset)."""
-    if not cfg.planner_sqp_iterations:
-        return None
+    """The planner configuration the actors' environments drive with: the robot's preset with
+    ``cfg.planner_changes()`` (None where there are none: the environment's own default, the preset)."""
     from lbgp.planner import planner_config_for
 
-    return planner_config_for(cfg.robot).with_(sqp_iterations=cfg.planner_sqp_iterations)
+    return planner_config_for(cfg.robot, cfg.planner_changes()) if cfg.planner_changes() else None
 
 
 class EnvCache:

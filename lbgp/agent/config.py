@@ -109,7 +109,7 @@ class D4PGConfig:
     # Off: over 3 seeds it scored 0.2 +- 5.4 lower on the paper scenarios (not separated; docs/ablations.md)
     planner_sqp_iterations: int = 0  # the planner's SQP iterations per band in training (0: the robot's
     # preset, 3); 1 is a stateless real-time iteration, ~2x faster (docs/planner.md, "The SQP iteration
-    # cap"). The policy is then meant for that planner: evaluate it with the same cap.
+    # cap"). The policy file records it (``planner_changes``) and is evaluated, demonstrated and deployed on that planner.
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
     # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
     # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
@@ -188,6 +188,11 @@ class D4PGConfig:
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
+
+    def planner_changes(self) -> dict:
+        """The planner settings the actors' environments change from the robot's preset ({}: none);
+        the policy file records them, and evaluation, the demo and deploy drive with them."""
+        return {"sqp_iterations": self.planner_sqp_iterations} if self.planner_sqp_iterations else {}
 
     # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
     # defaults table that have no option of their own, so that each can be ablated from the command line

@@ -4,7 +4,11 @@
     action = policy.act(observation)      # observation: the 57-number vector; action in [-1, 1]^2
 
 A policy file holds the actor's weights, its sizes, the method (lbgp: goal actions; e2e: (v, w)),
-the robot it was trained on, the observation layout version, and training facts.
+the robot it was trained on, the observation layout version, training facts, and the planner
+settings training changed from the robot's preset (``Policy.planner_changes``, e.g.
+``{"sqp_iterations": 1}`` after ``lbgp train --set planner_sqp_iterations=1``; {} for the shipped
+policies): ``lbgp evaluate``, ``demo`` and ``deploy`` drive the planner the policy was trained on
+(``lbgp.stack.policy_planner``).
 
 A residual LBGP policy acts with a goal dead band (``GOAL_DEADBAND_M``): its residual goal, the
 deviation from the goal 1.5 m ahead, is shrunk by that distance toward zero (a soft threshold), so
@@ -39,12 +43,13 @@ from lbgp.actions import action_from_goal, goal_from_action, mirror_action
 from lbgp.agent.checkpoint import load_checked, save_atomic
 from lbgp.agent.networks import Actor
 from lbgp.agent.previous_goal import agent_input, agent_input_size, first_previous_action, mirror_input, reads_previous_action
+from lbgp.planner.config import checked_changes
 from lbgp.sim import observation as obs_lib
 
 FORMAT = "lbgp-policy"
-VERSION = 5  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
-# 4: the motion-feature inputs; 5: the previous goal as an input
-READABLE = (1, 2, 3, 4, 5)
+VERSION = 6  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
+# 4: the motion-feature inputs; 5: the previous goal as an input; 6: the planner changes of training
+READABLE = (1, 2, 3, 4, 5, 6)
 GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
 MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
@@ -66,7 +71,7 @@ class Policy:
     """A deterministic actor: ``act(observation) -> action``."""
 
     def __init__(self, actor: Actor, method: str, meta: dict, goal_deadband: float = GOAL_DEADBAND_M,
-                 mirror_average: bool = MIRROR_AVERAGE):
+                 mirror_average: bool = MIRROR_AVERAGE, planner_changes: dict | None = None):
         if not (np.isfinite(goal_deadband) and goal_deadband >= 0.0):
             raise ValueError(f"goal_deadband must be a finite distance >= 0 m, got {goal_deadband!r}")
         self.actor = actor.eval()
@@ -77,6 +82,7 @@ class Policy:
         self.goal_deadband = float(goal_deadband) if self.actor.residual_scale > 0 and self.control == "goal" else 0.0
         self.mirror_average = bool(mirror_average)
         self.previous_goal = reads_previous_action(self.actor)
+        self.planner_changes = dict(planner_changes or {})  # PlannerConfig fields training changed from the preset
         self._previous = None
 
     def reset(self) -> None:
@@ -103,7 +109,10 @@ class Policy:
         return action
 
 
-def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict | None = None, residual_scale: float = 0.0) -> None:
+def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict | None = None, residual_scale: float = 0.0,
+                planner_changes: dict | None = None) -> None:
+    """Write a policy file atomically; ``planner_changes``: the planner settings (PlannerConfig fields)
+    the policy was trained with where they differ from the robot's preset."""
     save_atomic(
         {
             "format": FORMAT,
@@ -118,6 +127,7 @@ def save_policy(path, actor: Actor, method: str, robot: str, hidden, extra: dict
             "turn_lead": float(actor.turn_lead),
             "motion_features": bool(actor.inputs.motion_features),
             "previous_goal": reads_previous_action(actor),
+            "planner": checked_changes(planner_changes or {}),
             "actor": {k: v.detach().clone() for k, v in actor.state_dict().items()},
             "extra": dict(extra or {}),
         },
@@ -146,6 +156,7 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bo
                       residual_scale=float(data.get("residual_scale", 0.0)), turn_lead=float(data.get("turn_lead", 0.0)),
                       motion_features=bool(data.get("motion_features", False)))
         meta = {k: data[k] for k in ("robot", "hidden", "extra")}
+        planner_changes = checked_changes(data.get("planner", {}))  # none before version 6: the preset
         weights = dict(data["actor"])
         if data["version"] == 1:  # no standardisation, plain actor: identity buffers
             weights = {**{k: v for k, v in actor.state_dict().items() if k not in weights}, **weights}
@@ -158,4 +169,5 @@ def load_policy(path, goal_deadband: float = GOAL_DEADBAND_M, mirror_average: bo
         raise ValueError(f"{path}: actor weights do not match the stored sizes, expected {expected} ({reason})") from None
     if int(data["action_size"]) != 2:
         raise ValueError(f"{path}: policy has {data['action_size']} outputs, expected {expected}")
-    return Policy(actor, data["method"], meta, goal_deadband=goal_deadband, mirror_average=mirror_average)
+    return Policy(actor, data["method"], meta, goal_deadband=goal_deadband, mirror_average=mirror_average,
+                  planner_changes=planner_changes)

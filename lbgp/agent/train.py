@@ -319,7 +319,8 @@ class Trainer:
 
     def _save_policy(self, path: Path, actor, extra: dict) -> None:
         cfg = self.cfg
-        save_policy(path, actor, cfg.method, cfg.robot, cfg.hidden, extra=extra, residual_scale=cfg.actor_residual_scale)
+        save_policy(path, actor, cfg.method, cfg.robot, cfg.hidden, extra=extra, residual_scale=cfg.actor_residual_scale,
+                    planner_changes=cfg.planner_changes())
 
     def close(self) -> None:
         """Give the run folder back (its lock) without running: ``run`` does this itself."""

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from lbgp.robots import JACKAL, TURTLEBOT2, RobotSpec, get_robot
 
 PERSON_RADIUS = 0.25  # m, half the shoulder width of the simulated person
@@ -101,6 +103,30 @@ TURTLEBOT2_PLANNER = PlannerConfig(
 PRESETS = {"jackal": JACKAL_PLANNER, "turtlebot2": TURTLEBOT2_PLANNER}
 
 
-def planner_config_for(robot: str | RobotSpec) -> PlannerConfig:
+def planner_config_for(robot: str | RobotSpec, changes: dict | None = None) -> PlannerConfig:
+    """The robot's preset, with ``changes`` (field -> value, checked by ``checked_changes``) applied."""
     name = robot.name if isinstance(robot, RobotSpec) else get_robot(robot).name
-    return PRESETS[name]
+    return PRESETS[name].with_(**checked_changes(changes)) if changes else PRESETS[name]
+
+
+def checked_changes(changes) -> dict:
+    """``changes`` as a plain dict of ``PlannerConfig`` fields and values of their types (a policy
+    file carries such a dict); a ValueError naming the problem for anything else."""
+    if not isinstance(changes, dict):
+        raise ValueError(f"planner changes must be a mapping of PlannerConfig fields to values, got {type(changes).__name__}")
+    fields = {f.name: f for f in dataclasses.fields(PlannerConfig)}
+    checked = {}
+    for name, value in changes.items():
+        if name not in fields:
+            raise ValueError(f"{name!r} is not a planner setting (PlannerConfig has no such field)")
+        kind = str(fields[name].type)  # postponed annotations: "int", "float | None", "bool"
+        if value is None and "None" in kind:
+            checked[name] = None
+        elif kind == "bool" and isinstance(value, bool):
+            checked[name] = value
+        elif kind != "bool" and isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value) and (
+                not kind.startswith("int") or float(value).is_integer()):
+            checked[name] = int(value) if kind.startswith("int") else float(value)
+        else:
+            raise ValueError(f"planner setting {name} takes a value of type {kind}, got {value!r}")
+    return checked

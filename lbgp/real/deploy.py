@@ -39,6 +39,8 @@ def deploy(policy, source: str = "sim", sink: str | None = None, robot: str = "t
             calibrated = {} if calibration.is_identity else {"calibration": calibration.to_dict()}
             if drive_model is not None:
                 calibrated["drive_model"] = drive_model.to_dict()
+            if getattr(policy, "planner_changes", None):  # the planner the policy was trained on (DeployLoop drives it)
+                calibrated["planner_changes"] = dict(policy.planner_changes)
             logger = McapLogger(log, metadata={"robot": robot, "source": source, **calibrated, **(metadata or {})})
         if record or spawn_viewer:
             from lbgp.viz.recording import EpisodeRecorder

@@ -115,7 +115,8 @@ class DeployLoop:
         self.clock = clock or getattr(source, "clock", None) or WallClock()
         self.logger, self.recorder = logger, recorder
         self.end_condition = end_condition  # optional callable() -> reason or None (e.g. contact in sim)
-        self.limits = stack.planner_limits(self.cfg.robot, self.cfg.planner_period, time_budget=self.cfg.planner_time_budget)
+        self.limits = stack.planner_limits(self.cfg.robot, self.cfg.planner_period, stack.policy_planner(policy, self.cfg.robot),
+                                           time_budget=self.cfg.planner_time_budget)
         self.controller = stack.make_controller(policy.control, self.limits, self.cfg.drive_model, self.cfg.calibration)
         self.cfg.calibration.reset()  # an online calibration starts each run afresh
         self.monitor = SafetyMonitor(self.cfg.safety)

@@ -40,7 +40,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -55,6 +54,7 @@ from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 
 def run_policies(runs_dirs, variants: list[str] | None = None) -> dict[str, Path]:
@@ -228,7 +228,7 @@ def main(argv: list[str] | None = None) -> dict:
                 for m in mirrors:
                     jobs.append((acting_run_name(name, d, m, last), "e2e" if e2e else "lbgp", str(file), scenarios,
                                  args.episodes, args.seed, d, m, planner))
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")
     result = {

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -41,6 +40,7 @@ from lbgp.agent.train import CHECKPOINT_FORMAT  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 from lbgp.sim.observation import mirror  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 GRID = 5  # candidates per axis
 
@@ -110,7 +110,7 @@ def main(argv: list[str] | None = None) -> dict:
     scenarios = args.scenarios.split(",")
     jobs = [(f"{run.name}{'' if r is None else f'@critic{r:g}'}", str(run), r, scenarios, args.episodes, args.seed)
             for run in runs for r in [None, *radii]]
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))
     plain = {run.name: scored[run.name]["sum"] for run in runs}
     by_radius = {}

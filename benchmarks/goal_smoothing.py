@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +37,7 @@ from lbgp.actions import goal_from_action  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 
 class GoalFilter:
@@ -164,7 +164,7 @@ def main(argv: list[str] | None = None) -> dict:
     acting = [("smoothing", s) for s in [0.0, *smoothings]] + [("hold", h) for h in holds]
     jobs = [(run, str(path), kind, value, scenarios, args.episodes, args.seed) for run, path in policies.items() for kind, value in acting]
     runs: dict[str, dict[str, dict]] = {}
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         for run, key, per_scenario in pool.map(score, jobs):
             runs.setdefault(run, {})[key] = per_scenario
     result = {

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -34,6 +33,7 @@ from lbgp.agent.policy import GOAL_DEADBAND_M, shrink_residual  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 
 class EnsemblePolicy:
@@ -87,7 +87,7 @@ def main(argv: list[str] | None = None) -> dict:
     scenarios = args.scenarios.split(",")
     groups = sorted({g for files in ensembles for g in [files, *((f,) for f in files)]})
     jobs = [(g, name, args.episodes, args.seed) for g in groups for name in scenarios]
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         rewards = dict(pool.map(score, jobs))
 
     def sum_of(g):

@@ -35,7 +35,6 @@ beside the shipped one when ``--e2e-randomized`` names it.
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import json
 import math
 import sys
@@ -57,6 +56,7 @@ from lbgp.experiments.real_protocol import PATHS, SETTINGS, run_setting  # noqa:
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.real.sysid import identify, record_excitation  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 
 CALIBRATED = "hardware_like_calibrated"
@@ -194,7 +194,7 @@ def main() -> None:
     print(f"calibration: {summaries}", file=sys.stderr, flush=True)
     jobs = [(name, path, args, identified) for name, path in methods.items()]
     if args.jobs > 1:
-        with concurrent.futures.ProcessPoolExecutor(min(args.jobs, len(jobs))) as pool:
+        with process_pool(min(args.jobs, len(jobs))) as pool:
             done = list(pool.map(method_result, jobs))
     else:
         done = [method_result(job) for job in jobs]

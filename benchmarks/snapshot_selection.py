@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -40,6 +39,7 @@ from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import level_names, scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 
 def run_files(run_dir: Path) -> dict[str, Path]:
@@ -126,7 +126,7 @@ def main(argv: list[str] | None = None) -> dict:
         for n, f in files.items():
             jobs_v.append(((run, n), str(f), args.validation_episodes, args.validation_seed))
             jobs_t.append(((run, n), str(f), args.scenarios.split(","), args.episodes, args.seed))
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         validated = dict(pool.map(validate, jobs_v))
         tested = dict(pool.map(test, jobs_t))
     for (run, n), v in validated.items():

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +43,7 @@ from turn_lead_rule import group_sums  # noqa: E402
 from lbgp.actions import action_from_goal  # noqa: E402
 from lbgp.planner import TebPlanner, planner_config_for  # noqa: E402
 from lbgp.sim import make_env, scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 SPEED_KEYS = ("median_ms", "p99_ms", "sqp_iterations_per_call", "qp_solves", "osqp_iterations_per_qp", "goal_env_steps_per_s")
 
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> dict:
         jobs += [("sweep", k, robot) for k in caps for robot in robots]
     if "goal_jitter" in parts:
         jobs += [("jitter", k) for k in caps]
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    with process_pool(args.jobs) as pool:
         done = dict(pool.map(measure, jobs))
     for job, value in done.items():
         kind, k = job[0], str(job[1])

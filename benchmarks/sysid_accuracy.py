@@ -15,7 +15,6 @@ delay the log sees (docs/deploy.md, "What the fit can and cannot do").
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import itertools
 import sys
 import tempfile
@@ -27,6 +26,7 @@ from _common import write_result  # noqa: E402
 
 from lbgp.dynamics import nominal  # noqa: E402
 from lbgp.real.sysid import identify, record_excitation  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 LATENCY = 0.1
 LAGS = (0.1, 0.15, 0.25)
@@ -86,7 +86,7 @@ def main() -> None:
     jobs = list(itertools.product(args.robots.split(","), LAGS, (False, True), parse_seeds(args.seeds)))
     start = time.time()
     if args.jobs > 1:
-        with concurrent.futures.ProcessPoolExecutor(args.jobs) as pool:
+        with process_pool(args.jobs) as pool:
             fits = list(pool.map(one_fit, jobs))
     else:
         fits = [one_fit(job) for job in jobs]

@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -32,6 +31,7 @@ from lbgp.agent.learner import make_actor  # noqa: E402
 from lbgp.agent.policy import save_policy  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.parallel import process_pool  # noqa: E402
 
 GROUPS = {"turning": TURNING, "trajectories": TRAJECTORIES}
 
@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> dict:
         jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None)]
         jobs += [(f"lead {lead:g}", "lbgp", str(untrained_policy_file(Path(tmp), lead)), scenarios, args.episodes,
                   args.seed, None, None) for lead in leads]
-        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        with process_pool(args.jobs) as pool:
             scored = dict(pool.map(score, jobs))
     rows = {}
     for name, result in scored.items():

@@ -15,7 +15,6 @@ the paper's with the sign of alpha flipped.
 
 from __future__ import annotations
 
-import concurrent.futures
 import math
 from pathlib import Path
 
@@ -30,6 +29,7 @@ from lbgp.policies import make_policy
 from lbgp.real.loop import DeployConfig, DeployLoop
 from lbgp.real.sim_world import MocapDisturbance, SimCommandSink, SimPoseSource, SimWorld
 from lbgp.viz.trajectory_plot import TrajectoryCollector, plot_trajectories
+from lbgp.parallel import process_pool
 
 METHODS = ("lbgp", "hc", "e2e")
 END_DISTANCE = 3.0  # m (the paper's real-world termination)
@@ -119,7 +119,7 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
         raise ValueError(f"unknown dynamics set(s) {bad}; use {', '.join(DYNAMICS_SETS)}")
     work = [(dynamics, method, policies.get(method), paths, steps, seed, repeats) for dynamics in dynamics_sets for method in methods]
     if jobs > 1:
-        with concurrent.futures.ProcessPoolExecutor(min(jobs, len(work))) as pool:
+        with process_pool(min(jobs, len(work))) as pool:
             done = list(pool.map(method_rows, *zip(*work)))
     else:
         done = [method_rows(*job) for job in work]

@@ -108,3 +108,18 @@ def test_training_records_its_planner_and_deploy_drives_it(tmp_path):
     plain = DeployLoop(Source(), Sink(), ConstantGoalPolicy(), DeployConfig(robot="turtlebot2"), clock=lambda: 0.0)
     assert plain.limits.sqp_iterations == planner_config_for("turtlebot2").sqp_iterations
     assert np.isfinite(plain.limits.control_period)
+
+
+def test_the_sim_table_says_when_a_method_drives_another_planner(tmp_path):
+    from lbgp.experiments.sim_table import run_sim_table
+
+    save_policy(tmp_path / "cap1.pt", _actor(), "lbgp", "jackal", (16, 16), residual_scale=0.75,
+                planner_changes={"sqp_iterations": 1})
+    save_policy(tmp_path / "preset.pt", _actor(), "lbgp", "jackal", (16, 16), residual_scale=0.75)
+    for name in ("cap1", "preset"):
+        out = tmp_path / name
+        run_sim_table(out, episodes=1, scenarios=["straight_ahead"], methods=("lbgp", "hc"),
+                      policies={"lbgp": tmp_path / f"{name}.pt"}, horizon=4)
+        table = (out / "sim_table.md").read_text()
+        assert ("LBGP's planner: the jackal preset with sqp_iterations=1" in table) == (name == "cap1")
+        assert ("planner:" in table) == (name == "cap1")

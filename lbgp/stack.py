@@ -49,6 +49,14 @@ def policy_planner_note(policy, robot) -> str:
     return f"planner: the {name} preset with {settings} (the policy was trained on that planner)"
 
 
+def planner_notes(policies: dict, robot) -> str:
+    """For an experiment's table: a paragraph per method whose policy drives another planner than the
+    preset (``policies``: method name -> policy), "" when all drive the preset."""
+    notes = [f"{method.upper()}'s {note}; the other methods drive the preset.\n\n"
+             for method, policy in policies.items() if (note := policy_planner_note(policy, robot))]
+    return "".join(notes)
+
+
 def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None, calibration=None):
     """``goal``: the policy's goal goes through the planner (LBGP, HC); ``velocity``: the policy's
     (v, w) is clamped to the limits (E2E). ``drive_model`` (``lbgp.drive_model``): the planner keeps

@@ -123,3 +123,14 @@ def test_the_sim_table_says_when_a_method_drives_another_planner(tmp_path):
         table = (out / "sim_table.md").read_text()
         assert ("LBGP's planner: the jackal preset with sqp_iterations=1" in table) == (name == "cap1")
         assert ("planner:" in table) == (name == "cap1")
+
+
+def test_the_real_protocol_tables_say_when_a_method_drives_another_planner(tmp_path):
+    from lbgp.experiments.real_protocol import run_real_protocol
+
+    save_policy(tmp_path / "cap1.pt", _actor(), "lbgp", "jackal", (16, 16), residual_scale=0.75,
+                planner_changes={"sqp_iterations": 1})
+    run_real_protocol(tmp_path / "out", steps=3, methods=("lbgp", "hc"), paths=["straight"],
+                      policies={"lbgp": tmp_path / "cap1.pt"}, dynamics_sets=("nominal",))
+    table = (tmp_path / "out" / "real_protocol_table.md").read_text()
+    assert "LBGP's planner: the turtlebot2 preset with sqp_iterations=1" in table

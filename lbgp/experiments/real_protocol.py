@@ -25,11 +25,12 @@ from lbgp.drive_model import load_drive_model
 from lbgp.experiments import paper
 from lbgp.experiments.tables import write_tables
 from lbgp.metrics import aggregate
+from lbgp.parallel import process_pool
 from lbgp.policies import make_policy
 from lbgp.real.loop import DeployConfig, DeployLoop
 from lbgp.real.sim_world import MocapDisturbance, SimCommandSink, SimPoseSource, SimWorld
+from lbgp.stack import planner_notes
 from lbgp.viz.trajectory_plot import TrajectoryCollector, plot_trajectories
-from lbgp.parallel import process_pool
 
 METHODS = ("lbgp", "hc", "e2e")
 END_DISTANCE = 3.0  # m (the paper's real-world termination)
@@ -118,6 +119,8 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
     if bad or not dynamics_sets:
         raise ValueError(f"unknown dynamics set(s) {bad}; use {', '.join(DYNAMICS_SETS)}")
     work = [(dynamics, method, policies.get(method), paths, steps, seed, repeats) for dynamics in dynamics_sets for method in methods]
+    # the deploy loop drives the planner a policy was trained on (said in the tables)
+    notes = planner_notes({m: make_policy(m, policies.get(m), robot="turtlebot2", transfer=True) for m in methods}, "turtlebot2")
     if jobs > 1:
         with process_pool(min(jobs, len(work))) as pool:
             done = list(pool.map(method_rows, *zip(*work)))
@@ -142,7 +145,7 @@ def run_real_protocol(out_dir="results", steps: int = 60, seed: int = 0, methods
                     f"`lbgp deploy` loop with simulated mocap (noise, 10-30 ms latency, 2 % dropped frames), {steps} agent steps "
                     f"per setting unless it ends early on contact or D > {END_DISTANCE} m, {repeats} run(s) per setting. "
                     f"Paper numbers are from a real TurtleBot 2; their rows are mapped to settings by the order in the text "
-                    f"(see lbgp/experiments/paper.py for the caveat).\n\nMade by: "
+                    f"(see lbgp/experiments/paper.py for the caveat).\n\n{notes}Made by: "
                     f"`{command or 'lbgp experiment real-protocol --robot turtlebot2'}`")
         title = "Real-world protocol in simulation (paper Tables: straight, S shape, U-turn)"
         write_tables(rows, ["path", "setting"], paper.REAL, out_dir / f"real_protocol{suffix}_table.md",

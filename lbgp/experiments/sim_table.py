@@ -19,7 +19,7 @@ from lbgp.experiments import paper
 from lbgp.experiments.tables import write_tables
 from lbgp.policies import make_policy
 from lbgp.sim.tasks import SCENARIOS
-from lbgp.stack import policy_planner_note
+from lbgp.stack import planner_notes
 from lbgp.viz.trajectory_plot import TrajectoryCollector, plot_trajectories
 
 METHODS = ("lbgp", "hc", "e2e")
@@ -31,11 +31,9 @@ def run_sim_table(out_dir="results", episodes: int = 20, seed: int = 0, scenario
     out_dir = Path(out_dir)
     scenarios = list(scenarios or SCENARIOS)
     policies = policies or {}
-    rows, pictures, planner_notes = [], {s: {} for s in scenarios}, []
-    for method in methods:
-        policy = make_policy(method, policies.get(method))
-        if note := policy_planner_note(policy, "jackal"):  # evaluate drives the planner the policy was trained on
-            planner_notes.append(f"{method.upper()}'s {note}; the other methods drive the preset.")
+    rows, pictures = [], {s: {} for s in scenarios}
+    loaded = {method: make_policy(method, policies.get(method)) for method in methods}
+    for method, policy in loaded.items():
         for k, name in enumerate(scenarios):
             collector = TrajectoryCollector()
             # the seed depends on the scenario only, so that all methods face the same episodes
@@ -53,7 +51,7 @@ def run_sim_table(out_dir="results", episodes: int = 20, seed: int = 0, scenario
                 f"half-width of its 95 % confidence interval (the paper's episodes are longer, so compare rankings, not "
                 f"absolute rewards). Ceiling: the best return of a relaxed point robot at the planner's {vmax} m/s from the "
                 f"scenario's start (lbgp.experiments.ceiling), an upper bound for any method.\n\n"
-                + "".join(f"{note}\n\n" for note in planner_notes)
+                + planner_notes(loaded, "jackal")  # evaluate drives the planner a policy was trained on
                 + f"Made by: `{command or 'lbgp experiment sim'}`")
     write_tables(rows, ["scenario"], paper.SIM, out_dir / "sim_table.md", out_dir / "sim_table.csv",
                  "Simulation experiment (paper Table: simulation metrics)", preamble, ceilings=ceilings)

@@ -25,6 +25,7 @@ def test_checked_changes_accepts_planner_fields_and_refuses_anything_else():
     assert checked_changes({"sqp_iterations": 1.0, "wait_candidate": False, "osqp_refine_eps": None}) == {
         "sqp_iterations": 1, "wait_candidate": False, "osqp_refine_eps": None}
     assert type(checked_changes({"sqp_iterations": 1.0})["sqp_iterations"]) is int
+    assert checked_changes({"sqp_iterations": np.int64(2), "max_vel_x": np.float32(1.25)}) == {"sqp_iterations": 2, "max_vel_x": 1.25}
     assert planner_config_for("jackal", {"sqp_iterations": 1}) == planner_config_for("jackal").with_(sqp_iterations=1)
     for bad, words in [({"warp_speed": 1}, "'warp_speed' is not a planner setting"),
                        ({"sqp_iterations": 1.5}, "sqp_iterations takes a value of type int"),

@@ -9,6 +9,7 @@ so the limits below come from the robots' published top speeds, derated.
 from __future__ import annotations
 
 import dataclasses
+import numbers
 
 import numpy as np
 
@@ -124,7 +125,7 @@ def checked_changes(changes) -> dict:
             checked[name] = None
         elif kind == "bool" and isinstance(value, bool):
             checked[name] = value
-        elif kind != "bool" and isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value) and (
+        elif kind != "bool" and isinstance(value, numbers.Real) and not isinstance(value, bool) and np.isfinite(value) and (
                 not kind.startswith("int") or float(value).is_integer()):
             checked[name] = int(value) if kind.startswith("int") else float(value)
         else:

@@ -135,3 +135,17 @@ def test_the_real_protocol_tables_say_when_a_method_drives_another_planner(tmp_p
                       policies={"lbgp": tmp_path / "cap1.pt"}, dynamics_sets=("nominal",))
     table = (tmp_path / "out" / "real_protocol_table.md").read_text()
     assert "LBGP's planner: the turtlebot2 preset with sqp_iterations=1" in table
+
+
+def test_a_deploy_log_names_the_planner_it_drove(tmp_path):
+    from lbgp.real.deploy import deploy
+    from lbgp.real.mcap_log import read_log
+
+    save_policy(tmp_path / "cap1.pt", _actor(), "lbgp", "jackal", (16, 16), residual_scale=0.75,
+                planner_changes={"sqp_iterations": 1})
+    loop = deploy(load_policy(tmp_path / "cap1.pt"), source="sim://straight_ahead", robot="turtlebot2", steps=3,
+                  log=tmp_path / "run.mcap")
+    assert loop.error is None and loop.limits.sqp_iterations == 1
+    assert read_log(tmp_path / "run.mcap")["metadata"]["planner_changes"] == str({"sqp_iterations": 1})
+    deploy(ConstantGoalPolicy(), source="sim://straight_ahead", robot="turtlebot2", steps=3, log=tmp_path / "hc.mcap")
+    assert "planner_changes" not in read_log(tmp_path / "hc.mcap")["metadata"]

@@ -52,9 +52,9 @@ def policy_planner_note(policy, robot) -> str:
 def planner_notes(policies: dict, robot) -> str:
     """For an experiment's table: a paragraph per method whose policy drives another planner than the
     preset (``policies``: method name -> policy), "" when all drive the preset."""
-    notes = [f"{method.upper()}'s {note}; the other methods drive the preset.\n\n"
-             for method, policy in policies.items() if (note := policy_planner_note(policy, robot))]
-    return "".join(notes)
+    notes = [f"{method.upper()}'s {note}.\n\n" for method, policy in policies.items()
+             if (note := policy_planner_note(policy, robot))]
+    return "".join(notes) + ("The methods not named here drive the preset.\n\n" if notes else "")
 
 
 def make_controller(control: str, limits: PlannerConfig, drive_model: Dynamics | None = None, calibration=None):

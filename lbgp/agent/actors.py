@@ -146,10 +146,10 @@ def _true_poses(env) -> tuple[np.ndarray, np.ndarray]:
 
 def training_planner(cfg: D4PGConfig):
     """The planner configuration the actors' environments drive with: the robot's preset with
-    ``cfg.planner_changes()`` (None where there are none: the environment's own default, the preset)."""
+    ``cfg.planner_changes()`` (the preset itself where there are none)."""
     from lbgp.planner import planner_config_for
 
-    return planner_config_for(cfg.robot, cfg.planner_changes()) if cfg.planner_changes() else None
+    return planner_config_for(cfg.robot, cfg.planner_changes())
 
 
 class EnvCache:

@@ -116,7 +116,7 @@ def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: P
         md.write(f"| {' | '.join(map(str, key))} | {METHOD_NAMES.get(ours_best, ours_best)} | {METHOD_NAMES.get(paper_best, paper_best)} |\n")
     lbgp_wins = sum(1 for _, o, _ in summary if o == "lbgp")
     ties = sum(1 for _, o, _ in summary if o == TIE)
-    md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here, {ties} are ties (the paper: "
+    md.write(f"\nLBGP wins {lbgp_wins} of {len(summary)} rows here, {ties} {'is a tie' if ties == 1 else 'are ties'} (the paper: "
              f"{sum(1 for _, _, p in summary if p == 'lbgp')} of {len(summary)}).\n")
     h2h = head_to_head(rows, group_keys)
     if h2h is not None:

@@ -89,6 +89,7 @@ JACKAL_PLANNER = PlannerConfig(
     acc_lim_x=1.5,
     acc_lim_theta=3.0,
     lateral_acc_limit_clear=2.0,  # E2E's command range (1 m/s x 2 rad/s) allows as much; near the person 1.0 (docs/planner.md)
+    weight_turn=0.02,  # 0.05 until 2026-12-06: HC and LBGP both score more, HC's trajectory_three back (docs/planner.md, "Planner weights against the leads")
     footprint_radius=JACKAL.footprint_radius,
 )
 

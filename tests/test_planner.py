@@ -317,6 +317,29 @@ def test_the_jackal_turns_harder_at_speed_only_away_from_the_person():
     assert abs(gentle.v * gentle.w) <= cfg.lateral_acc_limit + 1e-9
 
 
+def test_the_turn_rate_is_weighed_as_sent_through_a_calibration_and_leaves_no_state():
+    """weight_turn prices the turn rate the wheels are sent: with a calibration scale s the band is
+    the one a planner weighing turns by weight_turn * s^2 plans without a scale (the lateral clear
+    limit, which also depends on s, left out), and a call with a scale leaves nothing behind: the
+    next call without one plans as a fresh planner does."""
+    cfg = JACKAL_PLANNER.with_(lateral_acc_limit_clear=None)
+    start, velocity, goal = [0.0, 0.0, 0.0], (1.0, 0.0), (4.0, 1.5, 0.3)
+    s = 1.7
+    planner = TebPlanner(cfg)
+    scaled = planner.plan(start, velocity, goal, FAR, (0.0, 0.0), command_scale_w=s)
+    heavier = TebPlanner(cfg.with_(weight_turn=cfg.weight_turn * s**2)).plan(start, velocity, goal, FAR, (0.0, 0.0))
+    plain = TebPlanner(cfg).plan(start, velocity, goal, FAR, (0.0, 0.0))
+    assert scaled.ok and heavier.ok and plain.ok
+    assert scaled.v == pytest.approx(heavier.v, abs=1e-6) and scaled.w == pytest.approx(heavier.w, abs=1e-6)
+    def turning(plan):  # the band's summed squared turn rate
+        return float(np.sum((np.diff(plan.poses[:, 2]) / cfg.band_dt) ** 2))
+
+    assert 0.0 < turning(scaled) < 0.85 * turning(plain)  # turns priced higher: the band turns less sharply
+    after = planner.plan(start, velocity, goal, FAR, (0.0, 0.0))
+    assert after.v == pytest.approx(plain.v, abs=1e-6) and after.w == pytest.approx(plain.w, abs=1e-6)
+    assert np.allclose(after.poses, plain.poses, atol=1e-5)
+
+
 def test_the_turn_limit_clear_of_the_person_bounds_the_command_a_calibration_sends():
     """A command calibration that doubles the turn rate on its way to the wheels (a base that turns
     half as much as told) halves what the band may use of lateral_acc_limit_clear, never below

@@ -43,7 +43,7 @@ class PlannerConfig:
     weight_heading_track: float = 0.2  # every pose's heading vs the goal's at that time (ramped like the tracking)
     weight_acc: float = 0.05  # squared change of v between segments (and from the current v)
     weight_alpha: float = 0.1  # squared change of w between segments (and from the current w)
-    weight_turn: float = 0.05  # squared w
+    weight_turn: float = 0.05  # squared w sent to the wheels (through a calibration's scale s: the band's w times s)
     weight_clearance_slack: float = 10.0  # quadratic penalty of a clearance violation (m)
     weight_clearance_l1: float = 100.0  # exact (L1) penalty of a clearance violation (m)
     clearance_tolerance: float = 0.02  # m the next pose may dip into the safety distance

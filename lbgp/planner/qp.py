@@ -65,7 +65,7 @@ class SparseQP:
     def __init__(self, n: int, m: int, P_values: np.ndarray, P_pattern, A_pattern, eps: float, max_iter: int,
                  rho: float = 0.1, refine_eps: float | None = None, refine_max_iter: int = 1000):
         self.n, self.m = n, m
-        self._P = sp.csc_matrix((np.asarray(P_values, dtype=float), *P_pattern), shape=(n, n))
+        self._P = sp.csc_matrix((np.array(P_values, dtype=float), *P_pattern), shape=(n, n))  # a copy: set_P_values writes into it
         self._A_pattern = A_pattern
         self._rho = rho  # the initial step size, set explicitly so that restart() can return to it
         self._settings = dict(verbose=False, polishing=True, warm_starting=True, eps_abs=eps, eps_rel=eps, max_iter=max_iter,
@@ -74,6 +74,7 @@ class SparseQP:
         # polished again; if that pass hits its cap, the iterate with the smaller residuals stands
         self._refine_eps, self._refine_max_iter = refine_eps, refine_max_iter
         self._solver = None
+        self._P_pending = False  # P's values changed since the solver last saw them
         self._infinity = 1e30  # OSQP_INFTY: bounds beyond it are infinite
         self.stats = QPStats()
         self.x = np.zeros(n)
@@ -81,6 +82,7 @@ class SparseQP:
     def reset(self) -> None:
         """Forget the warm start (the next solve sets OSQP up again)."""
         self._solver = None
+        self._P_pending = False
 
     def restart(self) -> None:
         """Start the next solve as a fresh solver would: from x = y = 0 with the initial rho (OSQP
@@ -91,6 +93,11 @@ class SparseQP:
         if self._solver is not None:
             self._solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.m))
             self._solver.update_rho(self._rho)
+
+    def set_P_values(self, P_values: np.ndarray) -> None:
+        """New values of P (the pattern's order), used from the next solve on."""
+        self._P.data[:] = P_values
+        self._P_pending = self._solver is not None
 
     def solve(self, A_values: np.ndarray, q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> str:
         """Solve with these values; returns ``solved`` (``x`` holds the solution),
@@ -106,7 +113,8 @@ class SparseQP:
             self._solver = wrapper._solver
         else:
             self._solver.update_data_vec(q=q, l=lower, u=upper)
-            self._solver.update_data_mat(P_x=None, P_i=None, A_x=A_values, A_i=None)
+            self._solver.update_data_mat(P_x=self._P.data if self._P_pending else None, P_i=None, A_x=A_values, A_i=None)
+            self._P_pending = False
             self.stats.update_seconds += time.perf_counter() - t_start
         self._solver.solve()
         stats = self.stats

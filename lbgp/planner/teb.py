@@ -153,7 +153,8 @@ class TebPlanner:
         ``goal_velocity`` ((0, 0): a fixed goal, stop there). ``command_scale_w``: what a command
         calibration will multiply the turn rate by on its way to the wheels (``lbgp.calibration``);
         ``lateral_acc_limit_clear`` bounds the command sent, so the band may use at most that
-        limit over this scale (never less than ``lateral_acc_limit``).
+        limit over this scale (never less than ``lateral_acc_limit``), and ``weight_turn`` prices the
+        turn rate sent, so the band's squared turn rate weighs ``weight_turn`` times its square.
         Never raises on bad numbers: returns a safe-stop plan whose status says why.
         """
         t_start = time.perf_counter()
@@ -199,6 +200,7 @@ class TebPlanner:
             lateral_clear=None if cfg.lateral_acc_limit_clear is None else
             max(cfg.lateral_acc_limit, cfg.lateral_acc_limit_clear / scale_w),
         )
+        self._price_turns(cfg.weight_turn * scale_w**2)
         candidates = ["keep"]
         if cfg.turn_around_candidate and self._goal_off_heading(problem):
             candidates.append("turn")
@@ -417,7 +419,14 @@ class TebPlanner:
         position[A_rows, A_cols] = np.arange(len(A_rows))
         self._kin_pos, self._clear_pos = position[self._kin_at], position[self._clear_at]
         self._Ax = A[A_rows, A_cols]  # the constant entries; band-dependent ones are set per QP
-        self._qp = SparseQP(n, m, np.triu(P)[P_at], (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),
+        # the turn rate's weight prices the rate *sent*: a calibration that scales it by s on its way to
+        # the wheels scales the weight by s^2 (``_price_turns``); where its entries sit in P's values
+        P_position = np.full((n, n), -1)
+        P_position[P_at] = np.arange(len(P_at[0]))
+        self._P_turn_pos = P_position[W + k, W + k]
+        self._P_values = np.triu(P)[P_at]
+        self._turn_weight = cfg.weight_turn
+        self._qp = SparseQP(n, m, self._P_values, (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),
                             cfg.osqp_eps, cfg.osqp_max_iter, cfg.osqp_rho,
                             cfg.osqp_refine_eps, cfg.osqp_refine_max_iter)
         self._q = np.zeros(n)
@@ -435,6 +444,19 @@ class TebPlanner:
         self._braking_w = cfg.acc_lim_theta * (cfg.control_period + h * np.arange(M))  # how far |w| can have dropped by segment k
         self._acc_w = np.full(M, cfg.acc_lim_theta * h)
         self._acc_w[0] = cfg.acc_lim_theta * cfg.control_period
+
+    def _price_turns(self, weight: float) -> None:
+        """Weigh the band's squared turn rate by ``weight`` (the objective's, the QP's and the
+        candidates' score); a function of this call's input only, so no call leaves state behind."""
+        if weight == self._turn_weight:
+            return
+        M = self.M
+        values = self._P_values.copy()
+        values[self._P_turn_pos] += 2.0 * (weight - self.cfg.weight_turn)
+        self._w_const = self._w_const.copy()
+        self._w_const[2 * M :] = weight
+        self._qp.set_P_values(values)
+        self._turn_weight = weight
 
     def _residuals(self, problem: _Problem, u: np.ndarray, poses: np.ndarray):
         """Tracking residuals (2M,), heading errors (M,), and the command residuals (3M,)."""

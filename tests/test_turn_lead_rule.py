@@ -37,6 +37,7 @@ def test_an_untrained_actor_scores_as_its_rule_on_the_sim_tables_episodes(tmp_pa
     (rule,) = evaluate(LeadRule(0.6), "lbgp", ["turning_inside"], episodes=2, seed=4000, obs_noise=True)
     assert rows["lead 0"]["sum"] == pytest.approx(constant["reward"], abs=2e-3)
     assert rows["lead 0.6"]["sum"] == pytest.approx(rule["reward"], abs=2e-3)
-    assert rows["lead 0.6"]["sum"] != pytest.approx(rows["lead 0"]["sum"], abs=0.05)  # the lead changes the episode
+    # the lead changes the episodes (by 0.04 on these two since the Jackal's turn weight is 0.02, 0.05+ before)
+    assert rows["lead 0.6"]["sum"] != pytest.approx(rows["lead 0"]["sum"], abs=0.01)
     assert rows["lead 0.6"]["minus_hc"]["sum"] == pytest.approx(rows["lead 0.6"]["sum"] - rows["HC"]["sum"], abs=1e-3)
     assert (tmp_path / "r.json").is_file()

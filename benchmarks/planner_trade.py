@@ -29,13 +29,16 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 from ablation_scenarios import score  # noqa: E402
-from turn_lead_rule import group_sums  # noqa: E402
+from turn_lead_rule import minus, summed_row  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
 from lbgp.planner import checked_changes, planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
+
+
+WORDS = {"none": None, "true": True, "false": False}
 
 
 def parse_variant(text: str) -> dict:
@@ -48,9 +51,14 @@ def parse_variant(text: str) -> dict:
         name, sep, value = item.partition("=")
         if not sep:
             raise ValueError(f"planner variant item {item!r} is not NAME=VALUE")
-        value = value.strip().lower()
-        changes[name.strip()] = {"none": None, "true": True, "false": False}.get(value) if value in ("none", "true", "false") \
-            else float(value)
+        name, value = name.strip(), value.strip().lower()
+        if value in WORDS:
+            changes[name] = WORDS[value]
+        else:
+            try:
+                changes[name] = float(value)
+            except ValueError:
+                raise ValueError(f"planner variant item {item!r}: {value!r} is not a number, none, true or false") from None
     return checked_changes(changes)
 
 
@@ -64,7 +72,7 @@ def measure(job: tuple) -> tuple[tuple, dict]:
     if job[0] == "score":
         _, _, method, episodes, seed = job
         _, result = score((method, method, None, scenario_names(), episodes, seed, None, None, changes))
-        return job, {"per_scenario": result["per_scenario"], "sum": result["sum"], **group_sums(result["per_scenario"])}
+        return job, summed_row(result)
     rows = evaluate(make_policy("hc"), "hc", scenario_names(), robot="jackal", episodes=5, seed=0,
                     planner_config=planner_config_for("jackal", changes))
     per_scenario = {row["scenario"]: round(row["reward"], 3) for row in rows}
@@ -94,8 +102,7 @@ def main(argv: list[str] | None = None) -> dict:
         entry = {"changes": dict(key), "scores": {}, "hc_original_protocol": done[("original", key)]}
         for seed in seeds:
             hc, lbgp = (done[("score", key, method, args.episodes, seed)] for method in ("hc", "lbgp"))
-            lead = {k: round(lbgp[k] - hc[k], 3) for k in hc if k != "per_scenario"}
-            entry["scores"][str(seed)] = {"hc": hc, "lbgp": lbgp, "lbgp_minus_hc": lead}
+            entry["scores"][str(seed)] = {"hc": hc, "lbgp": lbgp, "lbgp_minus_hc": minus(lbgp, hc)}
         result["variants"][variant_name(dict(key))] = entry
     write_result(args.json, result)
     for name, entry in result["variants"].items():

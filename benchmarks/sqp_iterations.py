@@ -38,7 +38,7 @@ from ablation_scenarios import score  # noqa: E402
 from bench_planner import bench  # noqa: E402
 from goal_jitter import jitter_rewards  # noqa: E402
 from goal_sweep import summarise, sweep  # noqa: E402
-from turn_lead_rule import group_sums  # noqa: E402
+from turn_lead_rule import minus, summed_row  # noqa: E402
 
 from lbgp.actions import action_from_goal  # noqa: E402
 from lbgp.planner import TebPlanner, planner_config_for  # noqa: E402
@@ -96,7 +96,7 @@ def measure(job: tuple) -> tuple[tuple, dict]:
     if kind == "score":
         _, _, method, episodes, seed = job
         _, result = score((method, method, None, scenario_names(), episodes, seed, None, None, {"sqp_iterations": k}))
-        return job, {"per_scenario": result["per_scenario"], "sum": result["sum"], **group_sums(result["per_scenario"])}
+        return job, summed_row(result)
     if kind == "sweep":
         robot = job[2]
         return job, summarise(sweep(robot, planner_config=planner_config_for(robot).with_(sqp_iterations=k)))
@@ -146,7 +146,7 @@ def main(argv: list[str] | None = None) -> dict:
         else:
             result.setdefault("goal_jitter", {})[k] = value
     for k, row in result.get("scores", {}).items():
-        row["lbgp_minus_hc"] = {key: round(row["lbgp"][key] - row["hc"][key], 3) for key in row["hc"] if key != "per_scenario"}
+        row["lbgp_minus_hc"] = minus(row["lbgp"], row["hc"])
     write_result(args.json, result)
     return result
 

@@ -50,6 +50,16 @@ def group_sums(per_scenario: dict) -> dict:
             if all(s in per_scenario for s in members)}
 
 
+def summed_row(scored: dict) -> dict:
+    """An ``ablation_scenarios.score`` result as a row: per scenario, the sum and the group sums."""
+    return {"per_scenario": scored["per_scenario"], "sum": scored["sum"], **group_sums(scored["per_scenario"])}
+
+
+def minus(row: dict, reference: dict) -> dict:
+    """``row``'s sum and group sums minus ``reference``'s (e.g. a method's lead over HC)."""
+    return {k: round(row[k] - reference[k], 3) for k in ("sum", *GROUPS) if k in row and k in reference}
+
+
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", default="results/turn_lead_rule.json")
@@ -69,11 +79,11 @@ def main(argv: list[str] | None = None) -> dict:
             scored = dict(pool.map(score, jobs))
     rows = {}
     for name, result in scored.items():
-        rows[name] = {"per_scenario": result["per_scenario"], "sum": result["sum"], **group_sums(result["per_scenario"])}
+        rows[name] = summed_row(result)
     hc = rows["HC"]
     for name, row in rows.items():
         if name != "HC":
-            row["minus_hc"] = {k: round(row[k] - hc[k], 3) for k in ("sum", *GROUPS) if k in row}
+            row["minus_hc"] = minus(row, hc)
     result = {"command": command_line("turn_lead_rule.py", argv),
               "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "rows": rows}
     write_result(args.json, result)

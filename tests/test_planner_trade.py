@@ -26,6 +26,8 @@ def test_variants_are_parsed_and_checked_against_the_planner_config():
         parse_variant("weigth_turn=0.05")
     with pytest.raises(ValueError, match="sqp_iterations"):
         parse_variant("sqp_iterations=2.5")
+    with pytest.raises(ValueError, match="'many' is not a number"):
+        parse_variant("weight_turn=many")
 
 
 def test_bad_variants_end_with_a_usage_error(tmp_path, capsys):

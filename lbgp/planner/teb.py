@@ -104,6 +104,14 @@ def safe_stop(v_now: float, w_now: float, cfg: PlannerConfig) -> tuple[float, fl
     return clamp_command(v, w, v_now, w_now, cfg)
 
 
+def _value_positions(shape, rows, cols) -> np.ndarray:
+    """(shape) array: where entry (i, j) of a sparse pattern with these rows and columns (in its CSC
+    values' order) sits among the values, -1 where the pattern has none."""
+    position = np.full(shape, -1)
+    position[rows, cols] = np.arange(len(rows))
+    return position
+
+
 @dataclasses.dataclass
 class _Problem:
     """Everything one call's QPs share (world frame)."""
@@ -415,15 +423,12 @@ class TebPlanner:
         A_rows, A_cols = A_pat.indices.copy(), np.repeat(np.arange(n), np.diff(A_pat.indptr))
         P_at = (P_pat.indices.copy(), np.repeat(np.arange(n), np.diff(P_pat.indptr)))
         # where each band-dependent entry sits in A's CSC values: the QP is updated in place
-        position = np.full((m, n), -1)
-        position[A_rows, A_cols] = np.arange(len(A_rows))
+        position = _value_positions((m, n), A_rows, A_cols)
         self._kin_pos, self._clear_pos = position[self._kin_at], position[self._clear_at]
         self._Ax = A[A_rows, A_cols]  # the constant entries; band-dependent ones are set per QP
         # the turn rate's weight prices the rate *sent*: a calibration that scales it by s on its way to
         # the wheels scales the weight by s^2 (``_price_turns``); where its entries sit in P's values
-        P_position = np.full((n, n), -1)
-        P_position[P_at] = np.arange(len(P_at[0]))
-        self._P_turn_pos = P_position[W + k, W + k]
+        self._P_turn_pos = _value_positions((n, n), *P_at)[W + k, W + k]
         self._P_values = np.triu(P)[P_at]
         self._turn_weight = cfg.weight_turn
         self._qp = SparseQP(n, m, self._P_values, (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),

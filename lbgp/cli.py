@@ -275,7 +275,7 @@ def cmd_experiment(args) -> int:
 
 
 GOAL_DEADBAND_HELP = ("LBGP: shrink the policy's residual goal this far toward the goal 1.5 m ahead "
-                      "(m; default 0.1, docs/training.md; 0: the actor's raw goal)")
+                      "(m; default 0.075, docs/training.md; 0: the actor's raw goal)")
 NO_MIRROR_HELP = ("act with the actor's own answer instead of the mean of its answers to the observation and to its mirror "
                   "image (lbgp, e2e; docs/training.md)")
 DRIVE_MODEL_HELP = ("the planner's model of the robot's drive: none (default: it acts at once), hardware_like, or lbgp sysid's "

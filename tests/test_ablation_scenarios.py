@@ -10,6 +10,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 from ablation_scenarios import acting_run_name, main, scenario_seed, summarise, variant_of  # noqa: E402
 
+from lbgp.agent.policy import GOAL_DEADBAND_M  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
 
@@ -25,7 +26,8 @@ def test_variants_are_summarised_over_their_seeds():
 
 
 def test_a_runs_other_acting_settings_are_variants_of_their_own():
-    assert acting_run_name("LBGP_s1", 0.1, mirror=True) == acting_run_name("LBGP_s1") == "LBGP_s1"  # the defaults
+    assert acting_run_name("LBGP_s1", GOAL_DEADBAND_M, mirror=True) == acting_run_name("LBGP_s1") == "LBGP_s1"  # the defaults
+    assert acting_run_name("LBGP_s1", GOAL_DEADBAND_M + 0.025) == f"LBGP@deadband{GOAL_DEADBAND_M + 0.025:g}_s1"
     assert acting_run_name("LBGP-no-curriculum_s2", 0.0) == "LBGP-no-curriculum@deadband0_s2"
     assert variant_of(acting_run_name("LBGP_s1", 0.2)) == "LBGP@deadband0.2"
     assert acting_run_name("E2E_s0", None, mirror=False) == "E2E@nomirror_s0"

@@ -61,8 +61,10 @@ def test_evaluate_writes_the_documented_json(tmp_path):
 
 
 def test_evaluate_goal_deadband_option_reaches_the_lbgp_policy(tmp_path):
+    from lbgp.agent.policy import GOAL_DEADBAND_M
+
     rewards = {}
-    for band in ("0", "0.1", "1.0"):
+    for band in ("0", f"{GOAL_DEADBAND_M:g}", "1.0"):
         out = tmp_path / f"m{band}.json"
         assert main(["evaluate", "--method", "lbgp", "--scenario", "turning_ahead", "--episodes", "1", "--goal-deadband", band,
                      "--json", str(out)]) == 0
@@ -70,7 +72,7 @@ def test_evaluate_goal_deadband_option_reaches_the_lbgp_policy(tmp_path):
     assert len(set(rewards.values())) == 3  # the raw actor, the default band, and a band that swallows every residual
     out = tmp_path / "default.json"
     assert main(["evaluate", "--method", "lbgp", "--scenario", "turning_ahead", "--episodes", "1", "--json", str(out)]) == 0
-    assert json.loads(out.read_text())[0]["reward"] == rewards["0.1"]  # 0.1 m is the default
+    assert json.loads(out.read_text())[0]["reward"] == rewards[f"{GOAL_DEADBAND_M:g}"]  # without the option: the default band
 
 
 def test_evaluate_no_mirror_option_gives_the_actors_own_answer(tmp_path):

@@ -12,7 +12,7 @@ from lbgp.agent.actors import ExplorationNoise
 from lbgp.agent.config import D4PGConfig
 from lbgp.agent.learner import D4PGLearner, make_actor
 from lbgp.agent.networks import MIN_OBS_STD, Actor
-from lbgp.agent.policy import load_policy, save_policy
+from lbgp.agent.policy import GOAL_DEADBAND_M, load_policy, save_policy
 from lbgp.sim import make_env
 from lbgp.sim import observation as obs_lib
 
@@ -134,9 +134,9 @@ def test_goal_dead_band_shrinks_the_residual_goal_toward_the_goal_ahead(tmp_path
     # a 0.3 m, 0.4 m residual (length 0.5 m) keeps its direction and loses 0.1 m of its length
     big = _residual_policy_file(tmp_path, math.atanh(0.3 / 0.75), math.atanh(0.4 / 0.75))
     assert np.allclose(goal_from_action(load_policy(big, goal_deadband=0.1, mirror_average=False).act(obs)), ahead + [0.24, 0.32], atol=1e-5)
-    # the defaults: 0.1 m, mirror averaged (a residual to the left whatever the observation cancels
-    # against its mirror image, to the right: 0.3 m straight ahead is left, 0.2 m after the band)
-    assert np.allclose(goal_from_action(load_policy(big).act(obs)), ahead + [0.2, 0.0], atol=1e-5)
+    # the defaults: GOAL_DEADBAND_M, mirror averaged (a residual to the left whatever the observation
+    # cancels against its mirror image, to the right: 0.3 m straight ahead is left, less the band)
+    assert np.allclose(goal_from_action(load_policy(big).act(obs)), ahead + [0.3 - GOAL_DEADBAND_M, 0.0], atol=1e-5)
     with pytest.raises(ValueError, match="goal_deadband"):
         load_policy(big, goal_deadband=float("nan"))
     with pytest.raises(ValueError, match="goal_deadband"):

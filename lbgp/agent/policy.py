@@ -50,7 +50,7 @@ FORMAT = "lbgp-policy"
 VERSION = 6  # 2: input standardisation buffers and the residual goal form; 3: the turn-aware base;
 # 4: the motion-feature inputs; 5: the previous goal as an input; 6: the planner changes of training
 READABLE = (1, 2, 3, 4, 5, 6)
-GOAL_DEADBAND_M = 0.1  # m: a residual policy's dead band around its base goal (0: the actor's raw goal)
+GOAL_DEADBAND_M = 0.075  # m: a residual policy's dead band around its base goal (0: the actor's raw goal); 0.1 until 2026-12-06 (docs/training.md)
 MIRROR_AVERAGE = True  # act with the mean of the actor's answers to the observation and its mirror image
 
 

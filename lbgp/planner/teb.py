@@ -430,7 +430,6 @@ class TebPlanner:
         # the wheels scales the weight by s^2 (``_price_turns``); where its entries sit in P's values
         self._P_turn_pos = _value_positions((n, n), *P_at)[W + k, W + k]
         self._P_values = np.triu(P)[P_at]
-        self._turn_weight = cfg.weight_turn
         self._qp = SparseQP(n, m, self._P_values, (P_pat.indices, P_pat.indptr), (A_pat.indices, A_pat.indptr),
                             cfg.osqp_eps, cfg.osqp_max_iter, cfg.osqp_rho,
                             cfg.osqp_refine_eps, cfg.osqp_refine_max_iter)
@@ -453,15 +452,13 @@ class TebPlanner:
     def _price_turns(self, weight: float) -> None:
         """Weigh the band's squared turn rate by ``weight`` (the objective's, the QP's and the
         candidates' score); a function of this call's input only, so no call leaves state behind."""
-        if weight == self._turn_weight:
+        turn = self._w_const[2 * self.M :]  # the weight in use: the score's entries, which the QP's P follows
+        if turn[0] == weight:
             return
-        M = self.M
         values = self._P_values.copy()
         values[self._P_turn_pos] += 2.0 * (weight - self.cfg.weight_turn)
-        self._w_const = self._w_const.copy()
-        self._w_const[2 * M :] = weight
+        turn[:] = weight
         self._qp.set_P_values(values)
-        self._turn_weight = weight
 
     def _residuals(self, problem: _Problem, u: np.ndarray, poses: np.ndarray):
         """Tracking residuals (2M,), heading errors (M,), and the command residuals (3M,)."""

@@ -2,8 +2,9 @@
 
 The JSON written by ``lbgp evaluate --json`` is a list with one entry per scenario:
 ``scenario, method, distance_mean, distance_std (m), alpha_mean_deg, alpha_std_deg, reward (mean
-accumulated reward per episode), reward_std, reward_ci95 (half-width of the 95 % interval of the mean), collisions, terminated_early (episode counts),
-steps (mean episode length), episodes, loops (episodes in which the robot's heading turned
+accumulated reward per episode), reward_std, reward_ci95 (half-width of the 95 % interval of the
+mean), episode_rewards (each episode's, in seed order), collisions, terminated_early (episode
+counts), steps (mean episode length), episodes, loops (episodes in which the robot's heading turned
 through more than 180 degrees relative to the person's while its goal stayed ahead of the person:
 see ``lbgp.metrics.LoopDetector``)``.
 """

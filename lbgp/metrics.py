@@ -123,6 +123,7 @@ def aggregate(episodes: list[EpisodeMetrics]) -> dict:
         "reward": float(np.mean(rewards)) if rewards else nan,
         "reward_std": float(np.std(rewards)) if rewards else nan,
         "reward_ci95": reward_ci95(rewards),
+        "episode_rewards": [float(r) for r in rewards],  # in episode (seed) order: methods pair up by index
         "collisions": int(sum(e.contact for e in episodes)),
         "terminated_early": int(sum(e.terminated_early for e in episodes)),
         "loops": int(sum(e.loops > 0 for e in episodes)),  # episodes with at least one loop

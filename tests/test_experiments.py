@@ -185,6 +185,38 @@ def test_head_to_head_counts_separated_and_overlapping_rows(tmp_path):
     assert head_to_head([row("a", "lbgp", 1.0, 0.1)], ["scenario"]) is None
 
 
+def test_lead_over_hc_is_summed_over_rows_and_paired_by_episode(tmp_path):
+    from lbgp.experiments.tables import paired_lead, write_tables
+    from lbgp.metrics import reward_ci95
+
+    def row(scenario, method, rewards):
+        return {"scenario": scenario, "method": method, "reward": float(np.mean(rewards)), "reward_ci95": reward_ci95(rewards),
+                "episode_rewards": list(rewards), "distance_mean": 1.5, "distance_std": 0.1, "alpha_mean_deg": 0.0,
+                "alpha_std_deg": 1.0, "collisions": 0, "terminated_early": 0}
+
+    # HC's episodes vary a lot, LBGP is HC plus a steady lead: pairing sees the steady lead
+    hc_a, hc_b = [10.0, 2.0, 7.0, 4.0], [1.0, 9.0, 3.0, 6.0]
+    rows = [row("a", "hc", hc_a), row("a", "lbgp", [r + 1.0 for r in hc_a]),
+            row("b", "hc", hc_b), row("b", "lbgp", [r + 2.0 + 0.1 * i for i, r in enumerate(hc_b)]),
+            row("c", "hc", [0.0, 0.0, 0.0, 0.0])]
+    lead = paired_lead(rows, ["a", "b"])
+    per_episode = [3.0, 3.1, 3.2, 3.3]
+    assert lead["lead"] == pytest.approx(3.15) and lead["episodes"] == 4
+    assert lead["ci95"] == pytest.approx(reward_ci95(per_episode))
+    assert lead["ci95"] < 0.25 < reward_ci95(hc_a)  # unpaired intervals would be far wider
+    assert paired_lead(rows, ["a"])["ci95"] == 0.0  # a constant lead is certain
+    with pytest.raises(ValueError, match="lbgp on c"):
+        paired_lead(rows, ["a", "c"])
+    rows.append(row("c", "lbgp", [1.0, 1.0]))
+    with pytest.raises(ValueError, match="same episodes"):
+        paired_lead(rows, ["a", "c"])
+    write_tables(rows[:4], ["scenario"], {}, tmp_path / "t.md", tmp_path / "t.csv", "title", "preamble",
+                 leads={"both": ("a", "b"), "missing": ("a", "z")})
+    md = (tmp_path / "t.md").read_text()
+    assert "LBGP - HC summed over the both rows (a, b): +3.15 ± " in md and "over 4 seeds" in md
+    assert "missing" not in md  # rows that did not run are not summed
+
+
 def test_reward_confidence_interval_is_students_t():
     from lbgp.metrics import reward_ci95
 

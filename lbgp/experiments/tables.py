@@ -7,7 +7,10 @@ import io
 import math
 from pathlib import Path
 
+import numpy as np
+
 from lbgp.files import write_text
+from lbgp.metrics import reward_ci95
 
 METHOD_NAMES = {"lbgp": "LBGP", "hc": "HC", "e2e": "E2E"}
 
@@ -49,6 +52,31 @@ def head_to_head(rows: list[dict], group_keys: list[str], a: str = "lbgp", b: st
             "mean_at_least": sum(1 for (ra, _), (rb, _) in pairs if ra >= rb)}
 
 
+def paired_lead(rows: list[dict], groups: list, a: str = "lbgp", b: str = "hc", group_key: str = "scenario") -> dict:
+    """Method ``a``'s reward minus ``b``'s summed over the rows ``groups`` (values of ``group_key``),
+    with the half-width of its 95 % interval, paired by episode: the rows' episodes are seeded alike
+    for every method (``lbgp.evaluate``), so episode i's lead is the sum over the rows of a's minus
+    b's return in their i-th episodes, and the sum of the rows' mean leads is the mean of those. Needs
+    ``episode_rewards`` in the rows and the same number of episodes in each; raises ValueError
+    naming what is missing."""
+    by_key = {(r[group_key], r["method"]): r for r in rows}
+    leads = None
+    for group in groups:
+        pair = []
+        for method in (a, b):
+            row = by_key.get((group, method))
+            if row is None or "episode_rewards" not in row:
+                raise ValueError(f"paired lead: no episode rewards of {method} on {group}")
+            pair.append(np.asarray(row["episode_rewards"], dtype=float))
+        if pair[0].shape != pair[1].shape or (leads is not None and leads.shape != pair[0].shape):
+            raise ValueError(f"paired lead: {group} has {pair[0].size} and {pair[1].size} episodes, the other rows {None if leads is None else leads.size}: "
+                             "pairing needs the same episodes everywhere")
+        leads = pair[0] - pair[1] if leads is None else leads + pair[0] - pair[1]
+    if leads is None:
+        raise ValueError("paired lead: no rows named")
+    return {"lead": float(leads.mean()), "ci95": reward_ci95(leads), "episodes": int(leads.size)}
+
+
 def head_to_head_csv(path, a: str = "lbgp", b: str = "hc") -> dict | None:
     """``head_to_head`` of a table's CSV (``results/sim_table.csv``, ``results/real_protocol*_table.csv``)."""
     with open(path, newline="") as f:
@@ -71,11 +99,12 @@ def _fmt_paper(p) -> tuple[str, str, str]:
 
 
 def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: Path, out_csv: Path, title: str, preamble: str,
-                 ceilings: dict | None = None) -> None:
+                 ceilings: dict | None = None, leads: dict | None = None) -> None:
     """``rows``: one dict per (group, method) with the evaluation keys; ``paper[group][method]``
     the paper's tuple (or None = failed). Winner per group by our reward, only where the 95 %
     intervals separate (else "tie"), and by the paper's. ``ceilings[group]``: the reward ceiling,
-    shown with each method's share of it."""
+    shown with each method's share of it. ``leads[name]``: groups (one key) over which LBGP's lead
+    over HC is summed and reported with its paired interval (``paired_lead``), where both ran them."""
     ceilings = ceilings or {}
     groups: dict = {}
     for r in rows:
@@ -123,6 +152,13 @@ def write_tables(rows: list[dict], group_keys: list[str], paper: dict, out_md: P
         md.write(f"\nLBGP against HC (the learned goal against the hand-crafted one, the same planner): higher in "
                  f"{h2h['higher']} and lower in {h2h['lower']} of {h2h['rows']} rows with the 95 % intervals separated, "
                  f"overlapping in {h2h['overlap']}; the higher or equal mean in {h2h['mean_at_least']}.\n")
+    methods = {r["method"] for r in rows}
+    present = {r[group_keys[0]] for r in rows}
+    for name, members in (leads or {}).items():
+        if {"lbgp", "hc"} <= methods and set(members) <= present:
+            lead = paired_lead(rows, members, group_key=group_keys[0])
+            md.write(f"\nLBGP - HC summed over the {name} rows ({', '.join(members)}): {lead['lead']:+.2f} ± {lead['ci95']:.2f} "
+                     f"(95 % interval, paired by episode over {lead['episodes']} seeds).\n")
     write_text(out_md, md.getvalue())
     buf = io.StringIO()
     if csv_rows:

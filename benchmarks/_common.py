@@ -21,3 +21,23 @@ def write_result(path: str, result: dict) -> None:
         json.dump(result, f, indent=2)
     os.replace(tmp, path)
     print(json.dumps(result, indent=2))
+
+
+TOP_SPEED_VMAX = 2.0  # m/s: the Jackal's top speed, the levels' ceilings' speed (the bound for any policy on it)
+
+
+def level_ceilings(path, vmax: float = TOP_SPEED_VMAX) -> dict[str, dict]:
+    """The training levels' point-robot ceilings from ``benchmarks/reward_ceiling.py``'s file, at
+    top speed ``vmax``, each level's row on the finest grid the file has for it (the closest to the
+    continuous bound): ``{level: row}`` with ``mean_bound``, ``mean_bound_starts_in_front_half`` and
+    ``..._back_half``. A missing file, or no row at ``vmax``, is a ValueError that says so."""
+    from lbgp.files import read_json
+
+    rows: dict[str, dict] = {}
+    for r in read_json(path, "reward ceiling")["results"]:
+        if abs(float(r["vmax"]) - vmax) < 1e-9 and (r["level"] not in rows or r["grid_m"] < rows[r["level"]]["grid_m"]):
+            rows[r["level"]] = r
+    if not rows:
+        speeds = sorted({float(r["vmax"]) for r in read_json(path, "reward ceiling")["results"]})
+        raise ValueError(f"reward ceiling file {path} has no rows at vmax {vmax} m/s (it has {speeds})")
+    return rows

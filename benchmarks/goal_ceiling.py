@@ -40,13 +40,12 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import command_line, write_result  # noqa: E402
+from _common import command_line, level_ceilings, write_result  # noqa: E402
 
 from lbgp.actions import DESIRED_GOAL, GOAL_X, GOAL_Y, action_from_goal, goal_from_action  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
-from lbgp.files import read_json  # noqa: E402
 from lbgp.sim import level_names, make_env  # noqa: E402
 from lbgp.sim.tasks import DEFAULT_HORIZON, SCENARIOS  # noqa: E402
 
@@ -201,8 +200,8 @@ def main(argv=None) -> dict:
         unknown = sorted(set(levels) - set(all_levels))
         if unknown:
             p.error(f"unknown levels {unknown}; use {', '.join(all_levels)}")
-        # the ceilings as benchmarks/levels_vs_ceiling.py reads them (the file's last row per level)
-        ceilings = {r["level"]: r["mean_bound"] for r in read_json(args.ceiling, "reward ceiling")["results"]}
+        # the ceilings as benchmarks/levels_vs_ceiling.py reads them (top speed, finest grid)
+        ceilings = {name: r["mean_bound"] for name, r in level_ceilings(args.ceiling).items()}
         jobs = [(name, args.robot, args.start_from, kwargs, (args.seed, all_levels.index(name), i))
                 for name in levels for i in range(args.episodes)]
     else:

@@ -4,6 +4,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
@@ -35,3 +36,40 @@ def test_a_candidate_lbgp_policy_is_scored_on_the_same_seeded_level_episodes(tmp
         assert rows[row["scenario"]]["share_of_ceiling"] == pytest.approx(row["reward"] / ceiling, abs=1e-3)
     # the flag really swapped the policy: another policy plays the same episodes differently
     assert any(abs(rows[k]["mean_return"] - shipped[k]["mean_return"]) > 1e-3 for k in rows)
+
+
+def test_start_sides_match_the_evaluated_episodes_and_split_their_returns():
+    from levels_vs_ceiling import by_start, starts_behind
+
+    from lbgp.geometry import distance_and_alpha
+    from lbgp.rollout import ConstantGoalPolicy
+    from lbgp.viz.trajectory_plot import TrajectoryCollector
+
+    levels, episodes = level_names()[:2], 8
+    behind = starts_behind(levels, episodes, seed=3)
+    for method, policy in (("e2e", make_policy("e2e", robot="jackal")), ("scripted", ConstantGoalPolicy())):
+        collector = TrajectoryCollector()
+        evaluate(policy, method, levels, robot="jackal", episodes=episodes, seed=3, recorder=collector, horizon=1)
+        # the spawn of each evaluated episode (its first logged state) is on the side starts_behind says
+        sides = [abs(distance_and_alpha(ep["robot"][0], ep["person"][0])[1]) > np.pi / 2 for ep in collector.episodes]
+        assert sides == [bool(b) for name in levels for b in behind[name]]
+    assert 0 < sum(b.sum() for b in behind.values()) < 2 * episodes  # both sides occur
+    ceiling = {"mean_bound_starts_in_front_half": 20.0, "mean_bound_starts_in_back_half": 10.0}
+    split = by_start([10.0, 2.0, 8.0], np.array([False, True, False]), ceiling)
+    assert split == {"front": {"episodes": 2, "mean_return": 9.0, "share_of_ceiling": 0.45},
+                     "behind": {"episodes": 1, "mean_return": 2.0, "share_of_ceiling": 0.2}}
+    assert by_start([1.0], np.array([False]), ceiling)["behind"] == {"episodes": 0, "mean_return": None, "share_of_ceiling": None}
+
+
+def test_ceilings_are_read_at_a_stated_speed_on_the_finest_grid(tmp_path):
+    from _common import level_ceilings
+
+    rows = [{"level": "straight", "vmax": v, "grid_m": g, "mean_bound": b} for v, g, b in
+            ((1.5, 0.06, 19.3), (2.0, 0.06, 21.9), (1.5, 0.046, 18.9), (2.0, 0.046, 21.4))]
+    path = tmp_path / "ceiling.json"
+    path.write_text(json.dumps({"results": rows}))
+    assert level_ceilings(path)["straight"]["mean_bound"] == 21.4  # top speed, finest grid, whatever the order
+    path.write_text(json.dumps({"results": rows[::-1]}))
+    assert level_ceilings(path, 1.5)["straight"]["mean_bound"] == 18.9
+    with pytest.raises(ValueError, match="no rows at vmax 1.0"):
+        level_ceilings(path, 1.0)

@@ -220,7 +220,8 @@ def main(argv=None) -> dict:
         if all(n in rows for n in names):
             sums[group] = {k: round(sum(rows[n][k] for n in names), 2)
                            for k in ("best", "constant_1_5", "hc", "lbgp", "point_robot_ceiling")}
-    result = {"benchmark": "goal_ceiling", "robot": args.robot, "settings": settings, "scenarios": rows, "sums": sums}
+    result = {"benchmark": "goal_ceiling", "robot": args.robot, "settings": settings,
+              "command": command_line("goal_ceiling.py", argv), "scenarios": rows, "sums": sums}
     write_result(args.json, result)
     return result
 

@@ -55,3 +55,18 @@ def test_a_training_level_episode_is_searched_and_replayed_by_its_seed():
     env.reseed([0, 1, 4])
     other = run_episode(env, GoalSequencePolicy(row["goals"], 7)).total_reward
     assert abs(other - row["best"]) > 1e-3
+
+
+def test_the_written_result_names_the_command_that_made_it(tmp_path):
+    import json
+
+    from goal_ceiling import main
+
+    out = tmp_path / "gc.json"
+    args = ["--scenarios", "straight_ahead", "--iterations", "1", "--population", "2", "--segment", "35",
+            "--workers", "1", "--json", str(out)]
+    result = main(args)
+    assert json.loads(out.read_text()) == result
+    assert result["command"] == "python benchmarks/goal_ceiling.py " + " ".join(args)
+    row = result["scenarios"]["straight_ahead"]
+    assert row["best"] >= row["constant_1_5"] - 1e-9  # the search keeps the constant goal if nothing beats it

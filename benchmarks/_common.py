@@ -33,11 +33,12 @@ def level_ceilings(path, vmax: float = TOP_SPEED_VMAX) -> dict[str, dict]:
     ``..._back_half``. A missing file, or no row at ``vmax``, is a ValueError that says so."""
     from lbgp.files import read_json
 
+    results = read_json(path, "reward ceiling")["results"]
     rows: dict[str, dict] = {}
-    for r in read_json(path, "reward ceiling")["results"]:
+    for r in results:
         if abs(float(r["vmax"]) - vmax) < 1e-9 and (r["level"] not in rows or r["grid_m"] < rows[r["level"]]["grid_m"]):
             rows[r["level"]] = r
     if not rows:
-        speeds = sorted({float(r["vmax"]) for r in read_json(path, "reward ceiling")["results"]})
+        speeds = sorted({float(r["vmax"]) for r in results})
         raise ValueError(f"reward ceiling file {path} has no rows at vmax {vmax} m/s (it has {speeds})")
     return rows

@@ -31,22 +31,24 @@ import numpy as np  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
-from lbgp.sim import level_names, make_env  # noqa: E402
+from lbgp.sim import level_names  # noqa: E402
 
 
-def starts_behind(levels: list[str], episodes: int, seed: int) -> dict[str, np.ndarray]:
-    """Per level, whether each of ``evaluate``'s seeded episodes (``evaluate(policy, m, levels,
-    episodes=episodes, seed=seed)``) spawns the robot behind the person (|alpha| > 90 deg)."""
-    out = {}
-    for k, name in enumerate(levels):
-        env = make_env(name, robot="jackal", seed=seed + 1000 * k)
-        behind = []
-        for i in range(episodes):
-            env.reseed([seed, k, i])  # as lbgp.evaluate seeds episode i of level k
-            env.reset()
-            behind.append(abs(float(env.info()["alpha"])) > math.pi / 2)
-        out[name] = np.array(behind)
-    return out
+class StartSides:
+    """An ``evaluate`` recorder that keeps only whether each episode starts with the robot behind
+    the person (|alpha| > 90 deg at its first logged state, the reset), in episode order."""
+
+    def __init__(self):
+        self.behind: list[bool] = []
+        self._first = False
+
+    def begin_episode(self, name: str, index: int = 0) -> None:
+        self._first = True
+
+    def log_step(self, info: dict, reward: float | None = None) -> None:
+        if self._first:
+            self.behind.append(abs(float(info["alpha"])) > math.pi / 2)
+            self._first = False
 
 
 def by_start(rewards, behind: np.ndarray, ceiling: dict) -> dict:
@@ -80,7 +82,6 @@ def main(argv: list[str] | None = None) -> dict:
         ap.error(str(exc))
     levels = level_names()
     ceilings = {name: bounds[name]["mean_bound"] for name in levels}
-    behind = starts_behind(levels, args.episodes, args.seed)
     command = command_line("levels_vs_ceiling.py", argv)
     out = {"command": command, "episodes": args.episodes, "ceiling_vmax": args.vmax, "ceilings": ceilings,
            "planner_vmax": planner_vmax, "planner_speed_ceilings": {name: planner_bounds[name]["mean_bound"] for name in levels},
@@ -88,7 +89,9 @@ def main(argv: list[str] | None = None) -> dict:
     for method in args.methods.split(","):
         policy_file = args.lbgp_policy if method == "lbgp" else None
         policy = make_policy(method, policy_file=policy_file, robot="jackal")
-        rows = evaluate(policy, method, levels, robot="jackal", episodes=args.episodes, seed=args.seed)
+        sides = StartSides()
+        rows = evaluate(policy, method, levels, robot="jackal", episodes=args.episodes, seed=args.seed, recorder=sides)
+        behind = dict(zip(levels, np.array(sides.behind).reshape(len(levels), args.episodes)))
         out["methods"][method] = {
             r["scenario"]: {"mean_return": round(r["reward"], 3), "ci95": round(r.get("reward_ci95", 0.0), 3),
                             "share_of_ceiling": round(r["reward"] / ceilings[r["scenario"]], 3),

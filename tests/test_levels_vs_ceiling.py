@@ -39,21 +39,21 @@ def test_a_candidate_lbgp_policy_is_scored_on_the_same_seeded_level_episodes(tmp
 
 
 def test_start_sides_match_the_evaluated_episodes_and_split_their_returns():
-    from levels_vs_ceiling import by_start, starts_behind
+    from levels_vs_ceiling import StartSides, by_start
 
     from lbgp.geometry import distance_and_alpha
     from lbgp.rollout import ConstantGoalPolicy
     from lbgp.viz.trajectory_plot import TrajectoryCollector
 
     levels, episodes = level_names()[:2], 8
-    behind = starts_behind(levels, episodes, seed=3)
-    for method, policy in (("e2e", make_policy("e2e", robot="jackal")), ("scripted", ConstantGoalPolicy())):
-        collector = TrajectoryCollector()
-        evaluate(policy, method, levels, robot="jackal", episodes=episodes, seed=3, recorder=collector, horizon=1)
-        # the spawn of each evaluated episode (its first logged state) is on the side starts_behind says
-        sides = [abs(distance_and_alpha(ep["robot"][0], ep["person"][0])[1]) > np.pi / 2 for ep in collector.episodes]
-        assert sides == [bool(b) for name in levels for b in behind[name]]
-    assert 0 < sum(b.sum() for b in behind.values()) < 2 * episodes  # both sides occur
+    sides = StartSides()
+    evaluate(ConstantGoalPolicy(), "scripted", levels, robot="jackal", episodes=episodes, seed=3, recorder=sides, horizon=3)
+    collector = TrajectoryCollector()
+    evaluate(ConstantGoalPolicy(), "scripted", levels, robot="jackal", episodes=episodes, seed=3, recorder=collector, horizon=3)
+    # one entry per episode, from its spawn (its first logged state), not from a later step
+    spawns = [abs(distance_and_alpha(ep["robot"][0], ep["person"][0])[1]) > np.pi / 2 for ep in collector.episodes]
+    assert sides.behind == spawns and len(spawns) == 2 * episodes
+    assert 0 < sum(spawns) < 2 * episodes  # both sides occur
     ceiling = {"mean_bound_starts_in_front_half": 20.0, "mean_bound_starts_in_back_half": 10.0}
     split = by_start([10.0, 2.0, 8.0], np.array([False, True, False]), ceiling)
     assert split == {"front": {"episodes": 2, "mean_return": 9.0, "share_of_ceiling": 0.45},

@@ -22,6 +22,13 @@ and replayed noise-free; per level the mean over the episodes of each return is 
 level's point-robot ceiling (``results/reward_ceiling.json``, as ``benchmarks/levels_vs_ceiling.py``
 reads it): what share of it a goal policy can reach through this planner and robot.
 
+``--react-after-deg D`` asks how much of that is anticipation: per episode the goals are held at
+LBGP's own, step by step, until the person's heading has turned by D degrees from its first value
+(the onset step, ``turn_onset``; the person's motion does not depend on the robot), and only the
+goals from there on are searched. A policy that reacts to a turn once it shows can at best reach
+this (still optimistic: after the onset the search knows the rest of the path); what the full
+search gains beyond it needs knowing that a turn comes before it shows.
+
 An open-loop sequence tuned to one deterministic episode knows the future, which no policy does,
 so its return is an optimistic target for LBGP; the search is not exhaustive either, so it is a
 lower bound on the best open-loop sequence (a closed-loop policy can beat a weak search). Reported
@@ -54,12 +61,16 @@ TRAJECTORIES = ("trajectory_one", "trajectory_two", "trajectory_three")
 
 
 class GoalSequencePolicy:
-    """Plays a fixed goal sequence: goal ``goals[k // segment]`` (person frame, m) at agent step k."""
+    """Plays a fixed goal sequence: goal ``goals[k // segment]`` (person frame, m) at agent step k;
+    with a ``prefix`` (one goal per step), ``prefix[k]`` for its steps first, then the segments."""
 
     control = "goal"
 
-    def __init__(self, goals, segment: int):
-        self.actions = [action_from_goal(g).astype(np.float32) for g in np.asarray(goals, float).reshape(-1, 2)]
+    def __init__(self, goals, segment: int, prefix=()):
+        def actions(g):
+            return [action_from_goal(x).astype(np.float32) for x in np.asarray(g, float).reshape(-1, 2)]
+
+        self.prefix, self.actions = actions(prefix), actions(goals)
         self.segment = segment
         self.k = 0
 
@@ -67,7 +78,8 @@ class GoalSequencePolicy:
         self.k = 0
 
     def act(self, observation) -> np.ndarray:
-        action = self.actions[min(self.k // self.segment, len(self.actions) - 1)]
+        k = self.k - len(self.prefix)
+        action = self.prefix[self.k] if k < 0 else self.actions[min(k // self.segment, len(self.actions) - 1)]
         self.k += 1
         return action
 
@@ -106,28 +118,49 @@ def closed_loop_goals(scenario: str, method: str, robot: str = "jackal", episode
     return play(make_env(scenario, robot=robot, seed=0, obs_noise=False), episode, policy), np.array(policy.goals)
 
 
+def turn_onset(scenario: str, degrees: float, robot: str = "jackal", episode=None) -> int:
+    """The first agent step at which the person's heading differs from its first value by at least
+    ``degrees`` (noise-free; a goal chosen at that step may react to the turn), or the horizon if never."""
+    env = make_env(scenario, robot=robot, seed=0, obs_noise=False)
+    if episode is not None:
+        env.reseed(list(episode))
+    timestep, yaws = env.reset(), [env.info()["person_pose"][2]]
+    while not timestep.last():
+        timestep = env.step(action_from_goal(DESIRED_GOAL))
+        yaws.append(env.info()["person_pose"][2])
+    turned = np.abs(np.degrees(np.unwrap(yaws) - yaws[0]))[:DEFAULT_HORIZON]
+    hits = np.flatnonzero(turned >= degrees)
+    return int(hits[0]) if hits.size else DEFAULT_HORIZON
+
+
 def search(scenario: str, robot: str = "jackal", segment: int = 5, population: int = 24, elites: int = 6,
-           iterations: int = 8, std: float = 0.4, seed: int = 0, start=None, episode=None) -> dict:
+           iterations: int = 8, std: float = 0.4, seed: int = 0, start=None, episode=None, frozen: int = 0) -> dict:
     """Cross-entropy search over one episode's goal sequence; returns the best sequence and its return.
 
     ``start``: a per-step goal sequence (35, 2) to start from (e.g. a closed-loop method's goals,
     whose open-loop replay is the same episode), averaged over each segment; default the constant
-    goal 1.5 m ahead. ``episode``: a training level's episode seed (``episode_env``)."""
+    goal 1.5 m ahead. ``episode``: a training level's episode seed (``episode_env``). ``frozen``:
+    the first steps play ``start``'s goals unchanged and only the later ones are searched (needs
+    ``start``); ``goals`` then holds the searched segments, ``prefix`` the frozen steps."""
+    if frozen and start is None:
+        raise ValueError("a frozen prefix needs a start sequence to freeze")
     env = make_env(scenario, robot=robot, seed=0, obs_noise=False)
     rng = np.random.default_rng(seed)
-    segments = -(-DEFAULT_HORIZON // segment)
+    frozen = min(int(frozen), DEFAULT_HORIZON - 1)
+    segments = -(-(DEFAULT_HORIZON - frozen) // segment)
     lo, hi = np.array([GOAL_X[0], GOAL_Y[0]]), np.array([GOAL_X[1], GOAL_Y[1]])
+    prefix = np.asarray(start, float).reshape(-1, 2)[:frozen] if frozen else np.zeros((0, 2))
 
     def score(goals):
-        return play(env, episode, GoalSequencePolicy(goals, segment))
+        return play(env, episode, GoalSequencePolicy(goals, segment, prefix))
 
-    constant = score(np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1)))
+    constant = play(env, episode, GoalSequencePolicy([DESIRED_GOAL], DEFAULT_HORIZON))
     if start is None:
         mean = np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1))
         best = constant
     else:
-        start = np.asarray(start, float).reshape(-1, 2)
-        mean = np.array([start[k * segment : (k + 1) * segment].mean(axis=0) for k in range(segments)])
+        rest = np.asarray(start, float).reshape(-1, 2)[frozen:]
+        mean = np.array([rest[k * segment : (k + 1) * segment].mean(axis=0) for k in range(segments)])
         best = score(mean)
     sigma = np.full_like(mean, std)
     best_goals = mean.copy()
@@ -142,16 +175,22 @@ def search(scenario: str, robot: str = "jackal", segment: int = 5, population: i
         elite = samples[order[:elites]]
         mean, sigma = elite.mean(axis=0), np.maximum(elite.std(axis=0), 0.02)
         history.append(best)
-    return {"constant_1_5": float(constant), "start": history[0], "best": float(best), "goals": best_goals.tolist(),
-            "history": [float(h) for h in history], "rollouts": 1 + (start is not None) + iterations * population}
+    row = {"constant_1_5": float(constant), "start": history[0], "best": float(best), "goals": best_goals.tolist(),
+           "history": [float(h) for h in history], "rollouts": 1 + (start is not None) + iterations * population}
+    if frozen:
+        row["prefix"] = prefix.tolist()
+    return row
 
 
 def one(args) -> dict:
-    scenario, robot, start_from, kwargs, episode = args
+    scenario, robot, start_from, kwargs, episode, *react = args
     hc, _ = closed_loop_goals(scenario, "hc", robot, episode)
     lbgp, lbgp_goals = closed_loop_goals(scenario, "lbgp", robot, episode)
-    row = search(scenario, robot, start=lbgp_goals if start_from == "lbgp" else None, episode=episode, **kwargs)
+    onset = turn_onset(scenario, react[0], robot, episode) if react and react[0] is not None else 0
+    row = search(scenario, robot, start=lbgp_goals if start_from == "lbgp" else None, episode=episode, frozen=onset, **kwargs)
     row["start_from"] = start_from
+    if onset:
+        row["onset_step"] = onset
     row["hc"], row["lbgp"] = hc, lbgp
     if episode is None:
         from lbgp.experiments.ceiling import scenario_ceiling
@@ -190,10 +229,17 @@ def main(argv=None) -> dict:
     p.add_argument("--std", type=float, default=0.4, help="initial search spread of each goal coordinate (m)")
     p.add_argument("--start-from", choices=("constant", "lbgp"), default="constant",
                    help="start the search at the constant goal 1.5 m ahead or at the shipped LBGP's goals")
+    p.add_argument("--react-after-deg", type=float, default=None,
+                   help="hold LBGP's own goals until the person has turned by this many degrees, search only after "
+                        "(needs --start-from lbgp)")
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
     args = p.parse_args(argv)
+    if args.react_after_deg is not None and (args.start_from != "lbgp" or args.react_after_deg <= 0):
+        p.error("--react-after-deg needs --start-from lbgp and a positive angle")
     kwargs = dict(iterations=args.iterations, population=args.population, segment=args.segment, std=args.std)
     settings = {**kwargs, "start_from": args.start_from}
+    if args.react_after_deg is not None:
+        settings["react_after_deg"] = args.react_after_deg
     if args.levels:
         all_levels = level_names()
         levels = [name for name in args.levels.split(",") if name]
@@ -202,10 +248,10 @@ def main(argv=None) -> dict:
             p.error(f"unknown levels {unknown}; use {', '.join(all_levels)}")
         # the ceilings as benchmarks/levels_vs_ceiling.py reads them (top speed, finest grid)
         ceilings = {name: r["mean_bound"] for name, r in level_ceilings(args.ceiling).items()}
-        jobs = [(name, args.robot, args.start_from, kwargs, (args.seed, all_levels.index(name), i))
+        jobs = [(name, args.robot, args.start_from, kwargs, (args.seed, all_levels.index(name), i), args.react_after_deg)
                 for name in levels for i in range(args.episodes)]
     else:
-        jobs = [(s, args.robot, args.start_from, kwargs, None) for s in args.scenarios.split(",") if s]
+        jobs = [(s, args.robot, args.start_from, kwargs, None, args.react_after_deg) for s in args.scenarios.split(",") if s]
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
         done = pool.map(one, jobs, chunksize=1)
     if args.levels:

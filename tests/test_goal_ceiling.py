@@ -4,10 +4,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from goal_ceiling import GoalSequencePolicy, closed_loop_goals, search  # noqa: E402
+from goal_ceiling import GoalSequencePolicy, closed_loop_goals, search, turn_onset  # noqa: E402
 
 from lbgp.actions import action_from_goal  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
@@ -22,6 +23,40 @@ def test_goal_sequence_holds_each_goal_for_its_segment_and_restarts_on_reset():
     np.testing.assert_allclose(played, expected, atol=1e-6)
     policy.reset()
     np.testing.assert_allclose(policy.act(None), action_from_goal(goals[0]), atol=1e-6)
+
+
+def test_a_prefix_is_played_step_by_step_before_the_segments():
+    prefix = [[1.2, 0.1], [1.3, -0.1], [1.4, 0.2]]
+    policy = GoalSequencePolicy([[2.0, 0.0], [1.0, 0.5]], segment=2, prefix=prefix)
+    played = [policy.act(None) for _ in range(8)]
+    expected = [action_from_goal(g) for g in prefix] + [action_from_goal(g) for g in ([2.0, 0.0],) * 2 + ([1.0, 0.5],) * 3]
+    np.testing.assert_allclose(played, expected, atol=1e-6)
+
+
+def test_the_turn_onset_is_where_the_persons_heading_first_turns_by_the_angle():
+    """The turning scenarios turn from the first step, the trajectories later (trajectory_two's
+    path bends before trajectory_three's), a straight walk never."""
+    assert turn_onset("turning_ahead", 2.0) == 1
+    two, three = turn_onset("trajectory_two", 5.0), turn_onset("trajectory_three", 5.0)
+    assert 1 < two < three < 35
+    assert turn_onset("trajectory_three", 2.0) < three  # a smaller angle shows sooner
+    assert turn_onset("straight_ahead", 2.0) == 35
+
+
+def test_a_frozen_prefix_replays_lbgps_own_goals_and_only_the_rest_is_searched():
+    lbgp, goals = closed_loop_goals("trajectory_three", "lbgp")
+    row = search("trajectory_three", population=3, elites=1, iterations=1, segment=2, start=goals, frozen=20)
+    np.testing.assert_allclose(row["prefix"], goals[:20])
+    assert len(row["goals"]) == 8  # (35 - 20) steps in segments of 2
+    env = make_env("trajectory_three", robot="jackal", seed=0, obs_noise=False)
+    replay = run_episode(env, GoalSequencePolicy(row["goals"], 2, row["prefix"]))
+    assert abs(replay.total_reward - row["best"]) < 1e-6
+    # up to the frozen step the episode is LBGP's own: its per-step goals replayed give the same rewards
+    whole = run_episode(make_env("trajectory_three", robot="jackal", seed=0, obs_noise=False), GoalSequencePolicy(goals, 1))
+    assert abs(whole.total_reward - lbgp) < 1e-3
+    np.testing.assert_allclose(replay.rewards[:20], whole.rewards[:20], atol=1e-9)
+    with pytest.raises(ValueError, match="frozen prefix needs a start"):
+        search("trajectory_three", population=2, iterations=1, frozen=5)
 
 
 def test_search_never_reports_less_than_the_constant_goal_and_its_best_sequence_replays_to_its_return():

@@ -105,3 +105,11 @@ def test_the_written_result_names_the_command_that_made_it(tmp_path):
     assert result["command"] == "python benchmarks/goal_ceiling.py " + " ".join(args)
     row = result["scenarios"]["straight_ahead"]
     assert row["best"] >= row["constant_1_5"] - 1e-9  # the search keeps the constant goal if nothing beats it
+
+
+def test_react_after_needs_lbgps_goals_to_hold(capsys):
+    from goal_ceiling import main
+
+    with pytest.raises(SystemExit):
+        main(["--scenarios", "trajectory_three", "--react-after-deg", "5", "--json", "unused.json"])
+    assert "--react-after-deg needs --start-from lbgp" in capsys.readouterr().err

@@ -89,13 +89,27 @@ class Policy:
         """Start of an episode or run: forget the previous action."""
         self._previous = None
 
-    @torch.no_grad()
-    def act(self, observation) -> np.ndarray:
+    def _actor_input(self, observation) -> np.ndarray:
+        """The observation checked, with the previous action after it when the actor reads it."""
         obs = np.asarray(observation, np.float32)
         if obs.shape != (obs_lib.SIZE,):
             raise ValueError(f"policy expects an observation of shape ({obs_lib.SIZE},), got {obs.shape}")
         if self.previous_goal:
             obs = agent_input(obs, first_previous_action(self.actor) if self._previous is None else self._previous)
+        return obs
+
+    @torch.no_grad()
+    def base_goal(self, observation) -> np.ndarray:
+        """The goal (person frame, m) a residual goal actor adds its residual to for ``observation``
+        (the goal 1.5 m ahead, moved ahead by a turn-aware base); a plain or E2E actor has none."""
+        if self.control != "goal" or self.actor.residual_scale <= 0:
+            raise ValueError(f"a base goal belongs to a residual goal policy; this one is a plain {self.method} actor")
+        base = self.actor.base_action(torch.from_numpy(self._actor_input(observation))[None])[0].numpy()
+        return goal_from_action(base)
+
+    @torch.no_grad()
+    def act(self, observation) -> np.ndarray:
+        obs = self._actor_input(observation)
         if self.mirror_average:
             own, of_mirror = self.actor(torch.from_numpy(np.stack([obs, mirror_input(obs)]))).numpy()
             action = (0.5 * (own + mirror_action(of_mirror))).astype(np.float32)

@@ -34,13 +34,11 @@ import numpy as np  # noqa: E402
 
 from ablation_scenarios import sim_table_rewards  # noqa: E402
 from lbgp.actions import action_from_goal, goal_from_action  # noqa: E402
+from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
-
-TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
-TRAJECTORIES = ("trajectory_one", "trajectory_two", "trajectory_three")
 
 
 class TransformedGoalPolicy:
@@ -126,8 +124,8 @@ def main(argv: list[str] | None = None) -> dict:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")["per_scenario"]
     for row in scored.values():
-        row["turning_minus_hc"] = rows_minus(row["per_scenario"], hc, TURNING)
-        row["trajectories_minus_hc"] = rows_minus(row["per_scenario"], hc, TRAJECTORIES)
+        row["turning_minus_hc"] = rows_minus(row["per_scenario"], hc, LEAD_ROWS["turning"])
+        row["trajectories_minus_hc"] = rows_minus(row["per_scenario"], hc, LEAD_ROWS["trajectory"])
     result = {"command": command_line("acting_transforms.py", argv), "policy": policy_file,
               "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios,
               "hc": {"per_scenario": hc, "sum": round(sum(hc.values()), 3)}, "variants": scored}

@@ -50,14 +50,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, level_ceilings, write_result  # noqa: E402
 
 from lbgp.actions import DESIRED_GOAL, GOAL_X, GOAL_Y, action_from_goal, goal_from_action  # noqa: E402
+from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
 from lbgp.sim import level_names, make_env  # noqa: E402
 from lbgp.sim.tasks import DEFAULT_HORIZON, SCENARIOS  # noqa: E402
 
-TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
-TRAJECTORIES = ("trajectory_one", "trajectory_two", "trajectory_three")
+TURNING, TRAJECTORIES = LEAD_ROWS["turning"], LEAD_ROWS["trajectory"]
 
 
 class GoalSequencePolicy:

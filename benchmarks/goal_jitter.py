@@ -20,11 +20,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_result  # noqa: E402
 
 from lbgp.actions import action_from_goal, goal_from_action  # noqa: E402
+from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
 from lbgp.sim import make_env  # noqa: E402
 
-TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
+TURNING = LEAD_ROWS["turning"]
 
 
 class JitteredGoal:

@@ -68,3 +68,30 @@ def test_a_bad_sqp_cap_is_refused_with_its_name(text):
 
 def test_the_sqp_cap_is_settable_from_the_command_line():
     assert D4PGConfig.parse_setting("planner_sqp_iterations=1") == ("planner_sqp_iterations", 1)
+
+
+def test_a_training_only_turn_weight_reaches_the_actors_planners_and_nothing_else(tmp_path):
+    """``train_planner_weight_turn`` changes the weight the actors' planners drive with (the rest of
+    the preset kept); the policy file the run writes does not record it, so the policy acts on the preset."""
+    from lbgp.agent.policy import load_policy
+    from lbgp.agent.train import Trainer
+
+    preset = _planner(D4PGConfig()).cfg
+    assert preset.weight_turn != 0.05
+    trained_on = _planner(D4PGConfig(train_planner_weight_turn=0.05), "trajectories").cfg
+    assert trained_on == preset.with_(weight_turn=0.05)
+    cfg = D4PGConfig(total_steps=100, min_replay=50, num_actors=1, hidden=(16, 16), batch_size=16,
+                     train_planner_weight_turn=0.05, planner_sqp_iterations=1)
+    assert cfg.training_planner_changes() == {"sqp_iterations": 1, "weight_turn": 0.05}
+    trainer = Trainer(cfg, tmp_path / "run", progress=False)
+    try:
+        path = trainer.snapshot()
+    finally:
+        trainer.close()
+    assert load_policy(path).planner_changes == {"sqp_iterations": 1}
+
+
+@pytest.mark.parametrize("text", ["train_planner_weight_turn=-0.01", "train_planner_weight_turn=11", "train_planner_weight_turn=nan"])
+def test_a_bad_training_turn_weight_is_refused_with_its_name(text):
+    with pytest.raises(ValueError, match="train_planner_weight_turn"):
+        D4PGConfig.parse_setting(text)

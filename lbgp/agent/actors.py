@@ -146,10 +146,10 @@ def _true_poses(env) -> tuple[np.ndarray, np.ndarray]:
 
 def training_planner(cfg: D4PGConfig):
     """The planner configuration the actors' environments drive with: the robot's preset with
-    ``cfg.planner_changes()`` (the preset itself where there are none)."""
+    ``cfg.training_planner_changes()`` (the preset itself where there are none)."""
     from lbgp.planner import planner_config_for
 
-    return planner_config_for(cfg.robot, cfg.planner_changes())
+    return planner_config_for(cfg.robot, cfg.training_planner_changes())
 
 
 class EnvCache:

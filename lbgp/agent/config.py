@@ -110,6 +110,10 @@ class D4PGConfig:
     planner_sqp_iterations: int = 0  # the planner's SQP iterations per band in training (0: the robot's
     # preset, 3); 1 is a stateless real-time iteration, ~2x faster (docs/planner.md, "The SQP iteration
     # cap"). The policy file records it (``planner_changes``) and is evaluated, demonstrated and deployed on that planner.
+    train_planner_weight_turn: float = 0.0  # > 0: the actors' planners weigh the squared turn rate by this
+    # instead of the preset's (the Jackal's 0.02; 0.05 before 2026-12-06, when the shipped policy was trained).
+    # Training only: unlike planner_sqp_iterations it is not recorded in the policy file, which acts on the
+    # preset; for testing whether a policy gains from training on a stiffer planner than it acts on (docs/ablations.md)
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
     # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
     # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
@@ -185,6 +189,8 @@ class D4PGConfig:
             raise ValueError(f"target_update_period must be >= 1 and target_tau in [0, 1], got {self.target_update_period}, {self.target_tau}")
         if not 0 <= self.planner_sqp_iterations <= 50:
             raise ValueError(f"planner_sqp_iterations must be from 0 (the preset) to 50, got {self.planner_sqp_iterations}")
+        if not (math.isfinite(self.train_planner_weight_turn) and 0.0 <= self.train_planner_weight_turn <= 10.0):
+            raise ValueError(f"train_planner_weight_turn must be from 0 (the preset) to 10, got {self.train_planner_weight_turn}")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -194,12 +200,21 @@ class D4PGConfig:
         the policy file records them, and evaluation, the demo and deploy drive with them."""
         return {"sqp_iterations": self.planner_sqp_iterations} if self.planner_sqp_iterations else {}
 
+    def training_planner_changes(self) -> dict:
+        """The planner settings the actors' environments drive with in training: ``planner_changes()``
+        plus the training-only turn-rate weight (which the policy file does not record)."""
+        changes = self.planner_changes()
+        if self.train_planner_weight_turn:
+            changes["weight_turn"] = self.train_planner_weight_turn
+        return changes
+
     # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
     # defaults table that have no option of their own, so that each can be ablated from the command line
     SETTABLE = ("sigma", "noise_correlation", "spawn_front_share", "residual_scale", "normalize_obs",
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
                 "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction", "hidden",
-                "target_update_period", "target_tau", "num_atoms", "v_min", "v_max", "planner_sqp_iterations")
+                "target_update_period", "target_tau", "num_atoms", "v_min", "v_max", "planner_sqp_iterations",
+                "train_planner_weight_turn")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

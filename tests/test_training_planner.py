@@ -70,19 +70,21 @@ def test_the_sqp_cap_is_settable_from_the_command_line():
     assert D4PGConfig.parse_setting("planner_sqp_iterations=1") == ("planner_sqp_iterations", 1)
 
 
-def test_a_training_only_turn_weight_reaches_the_actors_planners_and_nothing_else(tmp_path):
-    """``train_planner_weight_turn`` changes the weight the actors' planners drive with (the rest of
-    the preset kept); the policy file the run writes does not record it, so the policy acts on the preset."""
+
+def test_training_only_planner_changes_reach_the_actors_planners_and_nothing_else(tmp_path):
+    """``train_planner_changes`` changes the planner the actors' environments drive with (the rest of
+    the preset kept); the policy file the run writes does not record them, so the policy acts on the preset."""
     from lbgp.agent.policy import load_policy
     from lbgp.agent.train import Trainer
 
+    shipped_run = "weight_turn=0.05,lateral_acc_limit_clear=none"
     preset = _planner(D4PGConfig()).cfg
-    assert preset.weight_turn != 0.05
-    trained_on = _planner(D4PGConfig(train_planner_weight_turn=0.05), "trajectories").cfg
-    assert trained_on == preset.with_(weight_turn=0.05)
+    assert preset.weight_turn != 0.05 and preset.lateral_acc_limit_clear is not None
+    trained_on = _planner(D4PGConfig(train_planner_changes=shipped_run), "trajectories").cfg
+    assert trained_on == preset.with_(weight_turn=0.05, lateral_acc_limit_clear=None)
     cfg = D4PGConfig(total_steps=100, min_replay=50, num_actors=1, hidden=(16, 16), batch_size=16,
-                     train_planner_weight_turn=0.05, planner_sqp_iterations=1)
-    assert cfg.training_planner_changes() == {"sqp_iterations": 1, "weight_turn": 0.05}
+                     train_planner_changes=shipped_run, planner_sqp_iterations=1)
+    assert cfg.training_planner_changes() == {"sqp_iterations": 1, "weight_turn": 0.05, "lateral_acc_limit_clear": None}
     trainer = Trainer(cfg, tmp_path / "run", progress=False)
     try:
         path = trainer.snapshot()
@@ -91,7 +93,12 @@ def test_a_training_only_turn_weight_reaches_the_actors_planners_and_nothing_els
     assert load_policy(path).planner_changes == {"sqp_iterations": 1}
 
 
-@pytest.mark.parametrize("text", ["train_planner_weight_turn=-0.01", "train_planner_weight_turn=11", "train_planner_weight_turn=nan"])
-def test_a_bad_training_turn_weight_is_refused_with_its_name(text):
-    with pytest.raises(ValueError, match="train_planner_weight_turn"):
+@pytest.mark.parametrize("text, problem", [
+    ("train_planner_changes=weight_tur=0.05", "weight_tur"),
+    ("train_planner_changes=weight_turn=x", "weight_turn"),
+    ("train_planner_changes=weight_turn", "FIELD=VALUE"),
+    ("train_planner_changes=sqp_iterations=1.5", "sqp_iterations"),
+])
+def test_bad_training_planner_changes_are_refused_with_their_names(text, problem):
+    with pytest.raises(ValueError, match=f"train_planner_changes.*{problem}"):
         D4PGConfig.parse_setting(text)

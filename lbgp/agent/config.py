@@ -10,6 +10,8 @@ import dataclasses
 import json
 import math
 
+from lbgp.planner.config import changes_from_text
+
 
 @dataclasses.dataclass
 class D4PGConfig:
@@ -110,10 +112,11 @@ class D4PGConfig:
     planner_sqp_iterations: int = 0  # the planner's SQP iterations per band in training (0: the robot's
     # preset, 3); 1 is a stateless real-time iteration, ~2x faster (docs/planner.md, "The SQP iteration
     # cap"). The policy file records it (``planner_changes``) and is evaluated, demonstrated and deployed on that planner.
-    train_planner_weight_turn: float = 0.0  # > 0: the actors' planners weigh the squared turn rate by this
-    # instead of the preset's (the Jackal's 0.02; 0.05 before 2026-12-06, when the shipped policy was trained).
-    # Training only: unlike planner_sqp_iterations it is not recorded in the policy file, which acts on the
-    # preset; for testing whether a policy gains from training on a stiffer planner than it acts on (docs/ablations.md)
+    train_planner_changes: str = ""  # planner settings the actors' planners change in training only, as
+    # FIELD=VALUE pairs (lbgp.planner.config.changes_from_text), e.g. "weight_turn=0.05,lateral_acc_limit_clear=none":
+    # the Jackal planner the shipped policy was trained on (before 2026-12-05's lateral acceleration ramp and
+    # 2026-12-06's turn-rate weight). Unlike planner_sqp_iterations the policy file does not record them: the
+    # policy acts on the preset. For testing whether a policy gains from training on another planner (docs/ablations.md)
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the
     # person's true poses 0.2-1 s later and the robot's true pose, in the person's current frame
     # (lbgp.agent.critic_future, an asymmetric actor-critic); the actor and the policy file are unchanged
@@ -189,8 +192,10 @@ class D4PGConfig:
             raise ValueError(f"target_update_period must be >= 1 and target_tau in [0, 1], got {self.target_update_period}, {self.target_tau}")
         if not 0 <= self.planner_sqp_iterations <= 50:
             raise ValueError(f"planner_sqp_iterations must be from 0 (the preset) to 50, got {self.planner_sqp_iterations}")
-        if not (math.isfinite(self.train_planner_weight_turn) and 0.0 <= self.train_planner_weight_turn <= 10.0):
-            raise ValueError(f"train_planner_weight_turn must be from 0 (the preset) to 10, got {self.train_planner_weight_turn}")
+        try:
+            changes_from_text(self.train_planner_changes)
+        except ValueError as error:
+            raise ValueError(f"train_planner_changes: {error}") from None
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self
@@ -202,11 +207,8 @@ class D4PGConfig:
 
     def training_planner_changes(self) -> dict:
         """The planner settings the actors' environments drive with in training: ``planner_changes()``
-        plus the training-only turn-rate weight (which the policy file does not record)."""
-        changes = self.planner_changes()
-        if self.train_planner_weight_turn:
-            changes["weight_turn"] = self.train_planner_weight_turn
-        return changes
+        plus the training-only ``train_planner_changes`` (which the policy file does not record)."""
+        return {**self.planner_changes(), **changes_from_text(self.train_planner_changes)}
 
     # the fields `lbgp train --set NAME=VALUE` may change: the design choices of docs/training.md's
     # defaults table that have no option of their own, so that each can be ablated from the command line
@@ -214,7 +216,7 @@ class D4PGConfig:
                 "actor_warmup_updates", "drawn_paths", "batch_size", "actor_lr", "critic_lr", "n_step", "discount",
                 "critic_future", "snapshot_every_s", "priority_exponent", "priority_correction", "hidden",
                 "target_update_period", "target_tau", "num_atoms", "v_min", "v_max", "planner_sqp_iterations",
-                "train_planner_weight_turn")
+                "train_planner_changes")
 
     @classmethod
     def parse_setting(cls, text: str) -> tuple[str, object]:

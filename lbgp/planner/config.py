@@ -111,6 +111,26 @@ def planner_config_for(robot: str | RobotSpec, changes: dict | None = None) -> P
     return PRESETS[name].with_(**checked_changes(changes)) if changes else PRESETS[name]
 
 
+def changes_from_text(text: str) -> dict:
+    """``"weight_turn=0.05,lateral_acc_limit_clear=none"`` -> the checked changes dict (``checked_changes``):
+    comma-separated FIELD=VALUE pairs, VALUE a number, true / false, or none; "" -> {}."""
+    changes = {}
+    for item in filter(None, (part.strip() for part in text.split(","))):
+        name, sep, raw = item.partition("=")
+        name, raw = name.strip(), raw.strip()
+        if not sep or not name or not raw:
+            raise ValueError(f"planner changes are FIELD=VALUE pairs separated by commas, got {item!r}")
+        words = {"none": None, "true": True, "false": False}
+        if raw.lower() in words:
+            changes[name] = words[raw.lower()]
+        else:
+            try:
+                changes[name] = float(raw)
+            except ValueError:
+                raise ValueError(f"planner setting {name} takes a number, true, false or none, got {raw!r}") from None
+    return checked_changes(changes)
+
+
 def checked_changes(changes) -> dict:
     """``changes`` as a plain dict of ``PlannerConfig`` fields and values of their types (a policy
     file carries such a dict); a ValueError naming the problem for anything else."""

@@ -33,33 +33,15 @@ from turn_lead_rule import minus, summed_row  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
-from lbgp.planner import checked_changes, planner_config_for  # noqa: E402
+from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
 
-WORDS = {"none": None, "true": True, "false": False}
-
-
 def parse_variant(text: str) -> dict:
     """``"a=1.5,b=none"`` -> {"a": 1.5, "b": None}, checked against ``PlannerConfig`` (``preset``: {})."""
-    text = text.strip()
-    if text in ("", "preset"):
-        return {}
-    changes = {}
-    for item in text.split(","):
-        name, sep, value = item.partition("=")
-        if not sep:
-            raise ValueError(f"planner variant item {item!r} is not NAME=VALUE")
-        name, value = name.strip(), value.strip().lower()
-        if value in WORDS:
-            changes[name] = WORDS[value]
-        else:
-            try:
-                changes[name] = float(value)
-            except ValueError:
-                raise ValueError(f"planner variant item {item!r}: {value!r} is not a number, none, true or false") from None
-    return checked_changes(changes)
+    return {} if text.strip() in ("", "preset") else changes_from_text(text)
 
 
 def variant_name(changes: dict) -> str:

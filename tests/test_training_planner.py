@@ -96,7 +96,7 @@ def test_training_only_planner_changes_reach_the_actors_planners_and_nothing_els
 @pytest.mark.parametrize("text, problem", [
     ("train_planner_changes=weight_tur=0.05", "weight_tur"),
     ("train_planner_changes=weight_turn=x", "weight_turn"),
-    ("train_planner_changes=weight_turn", "FIELD=VALUE"),
+    ("train_planner_changes=weight_turn", "NAME=VALUE"),
     ("train_planner_changes=sqp_iterations=1.5", "sqp_iterations"),
 ])
 def test_bad_training_planner_changes_are_refused_with_their_names(text, problem):

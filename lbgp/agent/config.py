@@ -113,7 +113,7 @@ class D4PGConfig:
     # preset, 3); 1 is a stateless real-time iteration, ~2x faster (docs/planner.md, "The SQP iteration
     # cap"). The policy file records it (``planner_changes``) and is evaluated, demonstrated and deployed on that planner.
     train_planner_changes: str = ""  # planner settings the actors' planners change in training only, as
-    # FIELD=VALUE pairs (lbgp.planner.config.changes_from_text), e.g. "weight_turn=0.05,lateral_acc_limit_clear=none":
+    # NAME=VALUE pairs (lbgp.planner.config.changes_from_text), e.g. "weight_turn=0.05,lateral_acc_limit_clear=none":
     # the Jackal planner the shipped policy was trained on (before 2026-12-05's lateral acceleration ramp and
     # 2026-12-06's turn-rate weight). Unlike planner_sqp_iterations the policy file does not record them: the
     # policy acts on the preset. For testing whether a policy gains from training on another planner (docs/ablations.md)

@@ -113,22 +113,24 @@ def planner_config_for(robot: str | RobotSpec, changes: dict | None = None) -> P
 
 def changes_from_text(text: str) -> dict:
     """``"weight_turn=0.05,lateral_acc_limit_clear=none"`` -> the checked changes dict (``checked_changes``):
-    comma-separated FIELD=VALUE pairs, VALUE a number, true / false, or none; "" -> {}."""
+    comma-separated NAME=VALUE pairs, VALUE a number, true, false or none; "" -> {}."""
     changes = {}
     for item in filter(None, (part.strip() for part in text.split(","))):
         name, sep, raw = item.partition("=")
-        name, raw = name.strip(), raw.strip()
+        name, raw = name.strip(), raw.strip().lower()
         if not sep or not name or not raw:
-            raise ValueError(f"planner changes are FIELD=VALUE pairs separated by commas, got {item!r}")
-        words = {"none": None, "true": True, "false": False}
-        if raw.lower() in words:
-            changes[name] = words[raw.lower()]
+            raise ValueError(f"planner setting {item!r} is not NAME=VALUE")
+        if raw in CHANGE_WORDS:
+            changes[name] = CHANGE_WORDS[raw]
         else:
             try:
                 changes[name] = float(raw)
             except ValueError:
-                raise ValueError(f"planner setting {name} takes a number, true, false or none, got {raw!r}") from None
+                raise ValueError(f"planner setting {item!r}: {raw!r} is not a number, none, true or false") from None
     return checked_changes(changes)
+
+
+CHANGE_WORDS = {"none": None, "true": True, "false": False}
 
 
 def checked_changes(changes) -> dict:

@@ -70,7 +70,6 @@ def test_the_sqp_cap_is_settable_from_the_command_line():
     assert D4PGConfig.parse_setting("planner_sqp_iterations=1") == ("planner_sqp_iterations", 1)
 
 
-
 def test_training_only_planner_changes_reach_the_actors_planners_and_nothing_else(tmp_path):
     """``train_planner_changes`` changes the planner the actors' environments drive with (the rest of
     the preset kept); the policy file the run writes does not record them, so the policy acts on the preset."""

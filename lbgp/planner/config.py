@@ -111,6 +111,9 @@ def planner_config_for(robot: str | RobotSpec, changes: dict | None = None) -> P
     return PRESETS[name].with_(**checked_changes(changes)) if changes else PRESETS[name]
 
 
+CHANGE_WORDS = {"none": None, "true": True, "false": False}  # the words changes_from_text reads
+
+
 def changes_from_text(text: str) -> dict:
     """``"weight_turn=0.05,lateral_acc_limit_clear=none"`` -> the checked changes dict (``checked_changes``):
     comma-separated NAME=VALUE pairs, VALUE a number, true, false or none; "" -> {}."""
@@ -128,9 +131,6 @@ def changes_from_text(text: str) -> dict:
             except ValueError:
                 raise ValueError(f"planner setting {item!r}: {raw!r} is not a number, none, true or false") from None
     return checked_changes(changes)
-
-
-CHANGE_WORDS = {"none": None, "true": True, "false": False}
 
 
 def checked_changes(changes) -> dict:

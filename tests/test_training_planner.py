@@ -97,6 +97,7 @@ def test_training_only_planner_changes_reach_the_actors_planners_and_nothing_els
     ("train_planner_changes=weight_turn=x", "weight_turn"),
     ("train_planner_changes=weight_turn", "NAME=VALUE"),
     ("train_planner_changes=sqp_iterations=1.5", "sqp_iterations"),
+    ("train_planner_changes=weight_turn=0.05,sqp_iterations=1", "planner_sqp_iterations"),
 ])
 def test_bad_training_planner_changes_are_refused_with_their_names(text, problem):
     with pytest.raises(ValueError, match=f"train_planner_changes.*{problem}"):

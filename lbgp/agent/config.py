@@ -193,9 +193,12 @@ class D4PGConfig:
         if not 0 <= self.planner_sqp_iterations <= 50:
             raise ValueError(f"planner_sqp_iterations must be from 0 (the preset) to 50, got {self.planner_sqp_iterations}")
         try:
-            changes_from_text(self.train_planner_changes)
+            training_only = changes_from_text(self.train_planner_changes)
         except ValueError as error:
             raise ValueError(f"train_planner_changes: {error}") from None
+        if "sqp_iterations" in training_only:
+            raise ValueError("train_planner_changes: sqp_iterations is set with planner_sqp_iterations "
+                             "(the policy file records it, so the policy acts with the cap it was trained on)")
         if self.actor_warmup_updates < 0:
             raise ValueError(f"actor_warmup_updates must be >= 0, got {self.actor_warmup_updates}")
         return self

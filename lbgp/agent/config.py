@@ -114,7 +114,7 @@ class D4PGConfig:
     # cap"). The policy file records it (``planner_changes``) and is evaluated, demonstrated and deployed on that planner.
     train_planner_changes: str = ""  # planner settings the actors' planners change in training only, as
     # NAME=VALUE pairs (lbgp.planner.config.changes_from_text), e.g. "weight_turn=0.05,lateral_acc_limit_clear=none":
-    # the Jackal planner the shipped policy was trained on (before 2026-12-05's lateral acceleration ramp and
+    # the two Jackal planner settings the shipped policy was trained with (before 2026-12-05's lateral acceleration ramp and
     # 2026-12-06's turn-rate weight). Unlike planner_sqp_iterations the policy file does not record them: the
     # policy acts on the preset. For testing whether a policy gains from training on another planner (docs/ablations.md)
     critic_future: bool = False  # the critic (only) also sees the episode's next second in hindsight: the

@@ -29,6 +29,13 @@ choice kept elsewhere are compared with the ablation's LBGP runs on the same epi
 augmentation in training (docs/ablations.md):
 ``--runs results/ablation_runs,results/mirror_augment_runs --variants LBGP,LBGP-mirror-augment``.
 
+Each run (and HC) keeps its episodes' rewards per scenario (``episode_rewards``), so that runs can be
+set against each other on the same episodes: per run, its lead over HC summed over the turning
+rows, the trajectory rows and all rows (``over_hc``), and with ``--paired-with RUN`` its sum minus
+that run's (``minus_RUN``), each with a 95 % interval paired by episode (episode i of every row is
+the same for every policy, so the interval holds the episodes' noise, not the spread between
+training runs): whether one run's lead over another is more than the episodes' luck.
+
 ``--planner-sqp-iterations K`` scores every policy and HC on the planner with that SQP cap per band
 (runs trained with ``lbgp train --set planner_sqp_iterations=K``); E2E drives no planner. Without it
 every method drives the preset, even a policy whose file names another planner (``lbgp evaluate``
@@ -50,6 +57,8 @@ import numpy as np  # noqa: E402
 from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.policy import GOAL_DEADBAND_M, MIRROR_AVERAGE  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
+from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
+from lbgp.experiments.tables import paired_lead  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
@@ -100,12 +109,18 @@ def scenario_seed(seed: int, name: str) -> int:
     return seed + 1000 * scenario_names().index(name)
 
 
-def sim_table_rewards(policy, method: str, scenarios, episodes: int, seed: int, planner_config=None) -> dict[str, float]:
-    """``policy``'s mean reward (3 decimals) on each scenario's sim-table episodes (``scenario_seed``,
-    observation noise on, Jackal), by scenario name."""
+def sim_table_episodes(policy, method: str, scenarios, episodes: int, seed: int, planner_config=None) -> dict[str, list[float]]:
+    """``policy``'s accumulated reward in each of each scenario's sim-table episodes (``scenario_seed``,
+    observation noise on, Jackal), by scenario name, in the episodes' order."""
     rows = [evaluate(policy, method, [name], robot="jackal", episodes=episodes, seed=scenario_seed(seed, name),
                      obs_noise=True, planner_config=planner_config)[0] for name in scenarios]
-    return {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
+    return {r["scenario"]: [float(x) for x in r["episode_rewards"]] for r in rows}
+
+
+def sim_table_rewards(policy, method: str, scenarios, episodes: int, seed: int, planner_config=None) -> dict[str, float]:
+    """``policy``'s mean reward (3 decimals) on each scenario's sim-table episodes, by scenario name."""
+    per_episode = sim_table_episodes(policy, method, scenarios, episodes, seed, planner_config)
+    return {name: round(float(np.mean(rewards)), 3) for name, rewards in per_episode.items()}
 
 
 def sqp_cap(text: str) -> int:
@@ -123,10 +138,44 @@ def score(job: tuple) -> tuple[str, dict]:
     name, method, policy_file, scenarios, episodes, seed, deadband, mirror, *rest = job
     planner = planner_config_for("jackal", rest[0] if rest else None)
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
-    per_scenario = sim_table_rewards(policy, method, scenarios, episodes, seed, planner)
+    per_episode = sim_table_episodes(policy, method, scenarios, episodes, seed, planner)
+    per_scenario = {name: round(float(np.mean(rewards)), 3) for name, rewards in per_episode.items()}
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
                   "mirror_average": getattr(policy, "mirror_average", None), "per_scenario": per_scenario,
-                  "sum": round(float(sum(per_scenario.values())), 3)}
+                  "sum": round(float(sum(per_scenario.values())), 3),
+                  "episode_rewards": {name: [round(x, 3) for x in rewards] for name, rewards in per_episode.items()}}
+
+
+def paired_sum_difference(a: dict, b: dict, scenarios) -> dict | None:
+    """Run ``a``'s reward minus run ``b``'s summed over ``scenarios`` (the rows both scored), with the
+    95 % half-width paired by episode (``lbgp.experiments.tables.paired_lead``); None where either
+    lacks the episodes' rewards (a file from before they were kept) or no named row was scored."""
+    if "episode_rewards" not in a or "episode_rewards" not in b:
+        return None
+    rows = [name for name in scenarios if name in a["episode_rewards"] and name in b["episode_rewards"]]
+    if not rows:
+        return None
+    table = [{"scenario": name, "method": method, "episode_rewards": run["episode_rewards"][name]}
+             for name in rows for method, run in (("a", a), ("b", b))]
+    lead = paired_lead(table, rows, a="a", b="b")
+    half = lead["ci95"]
+    return {"difference": round(lead["lead"], 3), "ci95_half_width": round(half, 3) if np.isfinite(half) else None,
+            "separated": bool(np.isfinite(half) and abs(lead["lead"]) > half), "episodes": lead["episodes"], "rows": rows}
+
+
+def paired_comparisons(scored: dict[str, dict], hc: dict, paired_with: str | None = None) -> None:
+    """Adds to every run in ``scored`` its lead over ``hc`` (``over_hc``: the turning rows, the
+    trajectory rows and all rows) and, with ``paired_with`` (a run's name), its sum minus that
+    run's (``minus_<run>``), each paired by episode (``paired_sum_difference``)."""
+    if paired_with is not None and paired_with not in scored:
+        raise ValueError(f"--paired-with {paired_with}: no such run scored (runs: {', '.join(scored)})")
+    for name, run in scored.items():
+        everything = list(run.get("per_scenario", {}))
+        groups = {**LEAD_ROWS, "all": everything}
+        over_hc = {group: paired_sum_difference(run, hc, rows) for group, rows in groups.items()}
+        run["over_hc"] = {group: lead for group, lead in over_hc.items() if lead is not None}
+        if paired_with is not None and name != paired_with:
+            run[f"minus_{paired_with}"] = paired_sum_difference(run, scored[paired_with], everything)
 
 
 def welch_difference(a: list[float], b: list[float]) -> tuple[float, float | None]:
@@ -200,12 +249,18 @@ def main(argv: list[str] | None = None) -> dict:
                     help="comma-separated on/off: score every run with and/or without mirror-averaged acting")
     ap.add_argument("--last-actor", action="store_true",
                     help="also score each run's policy_last.pt (runs trained with --policy-average) as <variant>@last")
+    ap.add_argument("--paired-with", metavar="RUN",
+                    help="a scored run's name (e.g. LBGP-front09-2h_s0): every other run's sum minus its, paired by episode")
     ap.add_argument("--resummarise", action="store_true",
                     help="no scoring: summarise the runs already in --json again (after a change to the summary only)")
     args = ap.parse_args(argv)
     if args.resummarise:
         result = json.loads(Path(args.json).read_text())
         result["variants"] = summarise(result["runs"])
+        try:
+            paired_comparisons(result["runs"], result["hc"], args.paired_with)
+        except ValueError as error:
+            ap.error(str(error))
         write_result(args.json, result)
         return result
     scenarios = args.scenarios.split(",")
@@ -216,6 +271,8 @@ def main(argv: list[str] | None = None) -> dict:
     policies = run_policies(args.runs.split(","), args.variants.split(",") if args.variants else None)
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
+    if args.paired_with is not None and args.paired_with not in policies:
+        ap.error(f"--paired-with {args.paired_with}: no such run among {', '.join(policies)}")
     planner = D4PGConfig(planner_sqp_iterations=args.planner_sqp_iterations).planner_changes()
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None, planner)]
     for name, path in policies.items():
@@ -231,6 +288,7 @@ def main(argv: list[str] | None = None) -> dict:
     with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")
+    paired_comparisons(scored, hc, args.paired_with)
     result = {
         "command": command_line("ablation_scenarios.py", argv),
         "episodes_per_scenario": args.episodes, "seed": args.seed, "scenarios": scenarios, "planner_changes": planner,

@@ -130,3 +130,55 @@ def test_a_planner_cap_scores_hc_and_the_policies_on_that_planner(tmp_path):
     with pytest.raises(SystemExit):
         main(args + ["--planner-sqp-iterations", "-1", "--json", str(tmp_path / "bad.json")])
     assert not (tmp_path / "bad.json").exists()
+
+
+def test_two_runs_are_compared_on_the_same_episodes_with_a_paired_interval():
+    from ablation_scenarios import paired_comparisons, paired_sum_difference
+
+    a = {"per_scenario": {"turning_ahead": 0, "trajectory_one": 0},
+         "episode_rewards": {"turning_ahead": [10.0, 12.0, 14.0], "trajectory_one": [5.0, 5.0, 8.0]}}
+    b = {"per_scenario": {"turning_ahead": 0, "trajectory_one": 0},
+         "episode_rewards": {"turning_ahead": [9.0, 11.0, 12.0], "trajectory_one": [4.0, 5.0, 7.0]}}
+    # episode by episode, summed over both rows: 2, 1, 3 -> mean 2, std 1, t(0.975, 2) = 4.303 -> 4.303 / sqrt(3)
+    both = paired_sum_difference(a, b, ["turning_ahead", "trajectory_one"])
+    assert both["difference"] == 2.0 and both["ci95_half_width"] == pytest.approx(2.484, abs=1e-3)
+    assert not both["separated"] and both["episodes"] == 3
+    # turning_ahead alone: 1, 1, 2 -> mean 4/3, std 1/sqrt(3): half-width 4.303 / 3 = 1.434, not separated
+    one = paired_sum_difference(a, b, ["turning_ahead", "turning_behind"])  # a row neither scored is left out
+    assert one["rows"] == ["turning_ahead"] and one["difference"] == pytest.approx(1.333, abs=1e-3)
+    assert one["ci95_half_width"] == pytest.approx(1.434, abs=1e-3) and not one["separated"]
+    b_low = {**b, "episode_rewards": {k: [x - 10.0 for x in v] for k, v in b["episode_rewards"].items()}}
+    assert paired_sum_difference(a, b_low, ["turning_ahead"])["separated"]  # 11.33 +- 1.43
+    assert paired_sum_difference(a, {"per_scenario": {}}, ["turning_ahead"]) is None  # a file from before episodes were kept
+    with pytest.raises(ValueError, match="pairing needs the same episodes"):
+        paired_sum_difference(a, {"episode_rewards": {"turning_ahead": [1.0, 2.0]}}, ["turning_ahead"])
+
+    runs = {"X_s0": a, "Y_s0": b}
+    paired_comparisons(runs, b_low, paired_with="Y_s0")
+    assert runs["X_s0"]["minus_Y_s0"] == both and "minus_Y_s0" not in runs["Y_s0"]
+    assert runs["X_s0"]["over_hc"]["turning"]["rows"] == ["turning_ahead"]
+    # trajectory_one: mean 6 against b_low's (-6 - 5 - 3) / 3
+    assert runs["X_s0"]["over_hc"]["trajectory"]["difference"] == pytest.approx(6.0 + 14.0 / 3, abs=1e-3)
+    assert runs["Y_s0"]["over_hc"]["all"]["difference"] == pytest.approx(20.0)  # 10 higher in each row and episode
+    with pytest.raises(ValueError, match="no such run"):
+        paired_comparisons(runs, b_low, paired_with="Z_s0")
+
+
+def test_paired_with_sets_each_run_against_a_named_one(tmp_path):
+    runs = tmp_path / "runs"
+    for run in ("LBGP_s0", "LBGP_s1"):
+        (runs / run).mkdir(parents=True)
+        shutil.copy(default_policy_path("lbgp"), runs / run / "policy.pt")
+    args = ["--runs", str(runs), "--scenarios", "turning_ahead,trajectory_one", "--episodes", "2"]
+    result = main(args + ["--paired-with", "LBGP_s0", "--json", str(tmp_path / "out.json")])
+    same = result["runs"]["LBGP_s1"]["minus_LBGP_s0"]  # the same policy: every episode alike
+    assert same["difference"] == 0.0 and same["ci95_half_width"] == 0.0 and not same["separated"]
+    assert same["episodes"] == 2 and same["rows"] == ["turning_ahead", "trajectory_one"]
+    run, hc = result["runs"]["LBGP_s0"], result["hc"]
+    assert len(run["episode_rewards"]["turning_ahead"]) == 2
+    lead = run["over_hc"]["turning"]["difference"]
+    assert lead == pytest.approx(run["per_scenario"]["turning_ahead"] - hc["per_scenario"]["turning_ahead"], abs=2e-3)
+    assert run["over_hc"]["all"]["difference"] == pytest.approx(run["sum"] - hc["sum"], abs=3e-3)
+    with pytest.raises(SystemExit):
+        main(args + ["--paired-with", "LBGP_s7", "--json", str(tmp_path / "bad.json")])
+    assert not (tmp_path / "bad.json").exists()

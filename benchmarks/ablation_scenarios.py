@@ -119,7 +119,11 @@ def sim_table_episodes(policy, method: str, scenarios, episodes: int, seed: int,
 
 def sim_table_rewards(policy, method: str, scenarios, episodes: int, seed: int, planner_config=None) -> dict[str, float]:
     """``policy``'s mean reward (3 decimals) on each scenario's sim-table episodes, by scenario name."""
-    per_episode = sim_table_episodes(policy, method, scenarios, episodes, seed, planner_config)
+    return mean_rewards(sim_table_episodes(policy, method, scenarios, episodes, seed, planner_config))
+
+
+def mean_rewards(per_episode: dict[str, list[float]]) -> dict[str, float]:
+    """Each scenario's mean episode reward (3 decimals)."""
     return {name: round(float(np.mean(rewards)), 3) for name, rewards in per_episode.items()}
 
 
@@ -139,7 +143,7 @@ def score(job: tuple) -> tuple[str, dict]:
     planner = planner_config_for("jackal", rest[0] if rest else None)
     policy = make_policy(method, policy_file, robot="jackal", goal_deadband=deadband, mirror_average=mirror)
     per_episode = sim_table_episodes(policy, method, scenarios, episodes, seed, planner)
-    per_scenario = {name: round(float(np.mean(rewards)), 3) for name, rewards in per_episode.items()}
+    per_scenario = mean_rewards(per_episode)
     return name, {"method": method, "policy": policy_file, "goal_deadband": getattr(policy, "goal_deadband", None),
                   "mirror_average": getattr(policy, "mirror_average", None), "per_scenario": per_scenario,
                   "sum": round(float(sum(per_scenario.values())), 3),
@@ -271,8 +275,6 @@ def main(argv: list[str] | None = None) -> dict:
     policies = run_policies(args.runs.split(","), args.variants.split(",") if args.variants else None)
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
-    if args.paired_with is not None and args.paired_with not in policies:
-        ap.error(f"--paired-with {args.paired_with}: no such run among {', '.join(policies)}")
     planner = D4PGConfig(planner_sqp_iterations=args.planner_sqp_iterations).planner_changes()
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None, planner)]
     for name, path in policies.items():
@@ -285,6 +287,9 @@ def main(argv: list[str] | None = None) -> dict:
                 for m in mirrors:
                     jobs.append((acting_run_name(name, d, m, last), "e2e" if e2e else "lbgp", str(file), scenarios,
                                  args.episodes, args.seed, d, m, planner))
+    names = [job[0] for job in jobs[1:]]  # the runs as scored, acting variants included
+    if args.paired_with is not None and args.paired_with not in names:
+        ap.error(f"--paired-with {args.paired_with}: no such run among {', '.join(names)}")
     with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")

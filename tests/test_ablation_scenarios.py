@@ -182,3 +182,8 @@ def test_paired_with_sets_each_run_against_a_named_one(tmp_path):
     with pytest.raises(SystemExit):
         main(args + ["--paired-with", "LBGP_s7", "--json", str(tmp_path / "bad.json")])
     assert not (tmp_path / "bad.json").exists()
+    # an acting variant of a run is a run to pair with too
+    acting = main(["--runs", str(runs), "--scenarios", "turning_ahead", "--episodes", "1", "--deadbands", f"{GOAL_DEADBAND_M},0",
+                   "--paired-with", "LBGP@deadband0_s0", "--json", str(tmp_path / "acting.json")])
+    raw, kept = acting["runs"]["LBGP@deadband0_s0"], acting["runs"]["LBGP_s0"]
+    assert kept["minus_LBGP@deadband0_s0"]["difference"] == pytest.approx(kept["sum"] - raw["sum"], abs=2e-3)

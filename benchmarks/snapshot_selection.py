@@ -1,6 +1,7 @@
 """Choosing a run's actor by held-out training-level episodes instead of taking the last one.
 
     python benchmarks/snapshot_selection.py --runs runs/snapshots --json results/snapshot_selection.json --jobs 2
+    python benchmarks/snapshot_selection.py --runs DIR --validation scenarios --validation-seed 2000 --from-s 2700 --json OUT --jobs 2
 
 A run trained with ``--set snapshot_every_s=S`` keeps its policy file every S seconds in
 ``<run>/snapshots/`` (lbgp.agent.train). The last actor of a run is one point of an oscillating
@@ -8,10 +9,14 @@ actor-critic pair; this asks whether a rule that sees only training-distribution
 a better one. Every snapshot and the final ``policy.pt`` of every run is scored twice, acting as
 shipped (dead band, mirror averaging):
 
-- **validation**: the four training levels (random spawns and person motion, observation noise
-  on), ``--validation-episodes`` per level seeded ``[validation_seed, k, i]`` as ``lbgp evaluate``
-  seeds them (``--validation-seed`` 100: not the seed-0 episodes of levels_vs_ceiling.py), the same
-  episodes for every snapshot; summed over the levels. This is what the selection rule sees.
+- **validation**: with ``--validation levels`` (the default) the four training levels (random
+  spawns and person motion, observation noise on), ``--validation-episodes`` per level seeded
+  ``[validation_seed, k, i]`` as ``lbgp evaluate`` seeds them (``--validation-seed`` 100: not the
+  seed-0 episodes of levels_vs_ceiling.py); with ``--validation scenarios`` the test's own kind of
+  episode, the paper scenarios' fixed starts, but ``--validation-episodes`` other noisy episodes per
+  scenario, seeded by ``--validation-seed`` as the sim table seeds its own (a seed equal to the
+  test's is refused: the rule would see the test). The same episodes for every snapshot; summed.
+  This is what the selection rule sees.
 - **test**: the 9 paper scenarios on the sim table's 20 noisy seeded episodes each, summed
   (ablation_scenarios.py's scoring). The rule never sees it.
 
@@ -50,8 +55,11 @@ def run_files(run_dir: Path) -> dict[str, Path]:
 
 
 def validate(job: tuple) -> tuple[tuple, dict]:
-    """job: (key, policy_file, episodes, seed) -> (key, mean return per training level and their sum)."""
-    key, policy_file, episodes, seed = job
+    """job: (key, policy_file, episodes, seed[, scenarios]) -> (key, mean return per training level
+    and their sum); with ``scenarios``, those paper scenarios scored as the test scores them instead."""
+    key, policy_file, episodes, seed, *scenarios = job
+    if scenarios:
+        return test((key, policy_file, scenarios[0], episodes, seed))
     policy = make_policy("lbgp", policy_file, robot="jackal")
     rows = evaluate(policy, "lbgp", level_names(), robot="jackal", episodes=episodes, seed=seed)
     per_level = {r["scenario"]: round(float(r["reward"]), 3) for r in rows}
@@ -104,7 +112,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", required=True, help="comma-separated folders of runs (<variant>_s<seed>/policy.pt and snapshots/)")
     ap.add_argument("--json", default="results/snapshot_selection.json")
-    ap.add_argument("--validation-episodes", type=int, default=20, help="episodes per training level")
+    ap.add_argument("--validation", choices=("levels", "scenarios"), default="levels",
+                    help="what the rule sees: the training levels' random episodes, or other noisy episodes of the test's scenarios")
+    ap.add_argument("--validation-episodes", type=int, default=20, help="episodes per training level (or scenario)")
     ap.add_argument("--validation-seed", type=int, default=100)
     ap.add_argument("--scenarios", default=",".join(scenario_names()), help="comma-separated (the test; default: the 9 paper scenarios)")
     ap.add_argument("--episodes", type=int, default=20, help="episodes per paper scenario (the test)")
@@ -112,6 +122,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--from-s", type=float, default=0.0, help="choose only among policies written from this wall time (s) on")
     ap.add_argument("--jobs", type=int, default=1)
     args = ap.parse_args(argv)
+    scenarios = args.scenarios.split(",")
+    if args.validation == "scenarios" and args.validation_seed == args.seed:
+        ap.error(f"--validation scenarios with --validation-seed {args.seed}, the test's --seed: the rule would see the test's episodes")
     policies = run_policies(args.runs.split(","))
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}")
@@ -124,8 +137,9 @@ def main(argv: list[str] | None = None) -> dict:
             sys.exit(f"{final.parent} has no snapshots/: train it with --set snapshot_every_s=SECONDS")
         runs[run] = {"policies": {n: {"file": str(f), "wall_time_s": wall_seconds(n, final_s)} for n, f in files.items()}}
         for n, f in files.items():
-            jobs_v.append(((run, n), str(f), args.validation_episodes, args.validation_seed))
-            jobs_t.append(((run, n), str(f), args.scenarios.split(","), args.episodes, args.seed))
+            jobs_v.append(((run, n), str(f), args.validation_episodes, args.validation_seed)
+                          + ((scenarios,) if args.validation == "scenarios" else ()))
+            jobs_t.append(((run, n), str(f), scenarios, args.episodes, args.seed))
     with process_pool(args.jobs) as pool:
         validated = dict(pool.map(validate, jobs_v))
         tested = dict(pool.map(test, jobs_t))
@@ -136,8 +150,10 @@ def main(argv: list[str] | None = None) -> dict:
         run["selection"] = select(run, args.from_s)
     result = {
         "command": command_line("snapshot_selection.py", argv),
-        "validation": {"levels": level_names(), "episodes_per_level": args.validation_episodes, "seed": args.validation_seed},
-        "test": {"scenarios": args.scenarios.split(","), "episodes_per_scenario": args.episodes, "seed": args.seed},
+        "validation": ({"levels": level_names(), "episodes_per_level": args.validation_episodes, "seed": args.validation_seed}
+                       if args.validation == "levels" else
+                       {"scenarios": scenarios, "episodes_per_scenario": args.validation_episodes, "seed": args.validation_seed}),
+        "test": {"scenarios": scenarios, "episodes_per_scenario": args.episodes, "seed": args.seed},
         "from_s": args.from_s,
         "chosen_minus_final": over_runs([r["selection"]["chosen_minus_final"] for r in runs.values()]),
         "runs": runs,

@@ -100,3 +100,23 @@ def test_a_run_without_snapshots_is_refused(tmp_path):
     shutil.copy(SHIPPED, run / "policy.pt")
     with pytest.raises(SystemExit, match="snapshot_every_s"):
         main(["--runs", str(tmp_path / "runs"), "--json", str(tmp_path / "x.json")])
+
+
+def test_the_rule_can_see_other_episodes_of_the_test_scenarios_but_never_the_test_seed(tmp_path, capsys):
+    _run_with_a_bad_snapshot(tmp_path / "runs")
+    result = main(["--runs", str(tmp_path / "runs"), "--json", str(tmp_path / "selection.json"), "--validation", "scenarios",
+                   "--validation-episodes", "2", "--validation-seed", "7", "--scenarios", "straight_ahead", "--episodes", "1"])
+    assert result["validation"] == {"scenarios": ["straight_ahead"], "episodes_per_scenario": 2, "seed": 7}
+    run = result["runs"]["LBGP-test_s0"]
+    validation = {n: p["validation"] for n, p in run["policies"].items()}
+    assert all(list(v["per_scenario"]) == ["straight_ahead"] for v in validation.values())
+    assert validation["000100s"]["sum"] < validation["final"]["sum"] - 5  # the pushed residual loses there too
+    assert validation["000200s"] == validation["final"]
+    # other episodes than the test's: the same policy scores differently on them
+    assert validation["final"]["sum"] != run["policies"]["final"]["test"]["sum"]
+    assert run["selection"]["chosen"] != "000100s"
+    with pytest.raises(SystemExit):
+        main(["--runs", str(tmp_path / "runs"), "--json", str(tmp_path / "same.json"), "--validation", "scenarios",
+              "--validation-seed", "0", "--seed", "0"])
+    assert "the rule would see the test's episodes" in capsys.readouterr().err
+    assert not (tmp_path / "same.json").exists()

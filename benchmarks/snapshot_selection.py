@@ -1,4 +1,4 @@
-"""Choosing a run's actor by held-out training-level episodes instead of taking the last one.
+"""Choosing a run's actor by held-out episodes (training levels, or the paper scenarios' fixed starts) instead of the last one.
 
     python benchmarks/snapshot_selection.py --runs runs/snapshots --json results/snapshot_selection.json --jobs 2
     python benchmarks/snapshot_selection.py --runs DIR --validation scenarios --validation-seed 2000 --from-s 2700 --json OUT --jobs 2

@@ -2,6 +2,7 @@
 
     python benchmarks/snapshot_selection.py --runs runs/snapshots --json results/snapshot_selection.json --jobs 2
     python benchmarks/snapshot_selection.py --runs DIR --validation scenarios --validation-seed 2000 --from-s 2700 --json OUT --jobs 2
+    python benchmarks/snapshot_selection.py --runs DIR2 --reuse OUT --validation scenarios --validation-seed 2000 --from-s 2700 --json OUT2 --jobs 2
 
 A run trained with ``--set snapshot_every_s=S`` keeps its policy file every S seconds in
 ``<run>/snapshots/`` (lbgp.agent.train). The last actor of a run is one point of an oscillating
@@ -25,6 +26,10 @@ Per run the rule picks the policy with the highest validation sum among those wr
 the final policy's (paired: the same run), and over the runs their mean with a 95 % t interval.
 It also gives, per run, Spearman's rank correlation of validation and test sums over the snapshots:
 how well the training levels rank the actors of one run for the scenarios.
+
+``--reuse FILE[,FILE]`` adds the runs an earlier result of this script scored (with the same
+validation and test episodes) without scoring them again, so runs trained in different sessions
+are summarised together; a run both there and under ``--runs`` takes the file's scores.
 """
 
 from __future__ import annotations
@@ -79,8 +84,8 @@ def wall_seconds(name: str, final_s: float) -> float:
 
 
 def spearman(a: list[float], b: list[float]) -> float | None:
-    if len(a) < 3:
-        return None
+    if len(a) < 3 or len(set(a)) == 1 or len(set(b)) == 1:
+        return None  # too few, or constant: no rank correlation
     from scipy import stats
 
     return round(float(stats.spearmanr(a, b).statistic), 3)
@@ -108,9 +113,30 @@ def over_runs(differences: list[float]) -> dict:
             "separated": None if half is None else bool(abs(mean) > half)}
 
 
+def reused_runs(files: list[str], validation: dict, test_episodes: dict) -> dict[str, dict]:
+    """The scored runs of earlier results of this script, each checked to have been scored on the
+    same validation and test episodes as this command's (a ValueError naming the file otherwise)."""
+    from lbgp.files import read_json
+
+    runs: dict[str, dict] = {}
+    for path in files:
+        earlier = read_json(path, "snapshot selection result")
+        if not isinstance(earlier, dict) or not isinstance(earlier.get("runs"), dict):
+            raise ValueError(f"{path} is not a result of snapshot_selection.py (no runs)")
+        for part, ours in (("validation", validation), ("test", test_episodes)):
+            if earlier.get(part) != ours:
+                raise ValueError(f"{path} was scored on other {part} episodes ({earlier.get(part)}) than this command's ({ours})")
+        for name, run in earlier["runs"].items():
+            if name in runs:
+                raise ValueError(f"run {name} is in two reused files")
+            runs[name] = {"policies": run["policies"]}
+    return runs
+
+
 def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--runs", required=True, help="comma-separated folders of runs (<variant>_s<seed>/policy.pt and snapshots/)")
+    ap.add_argument("--runs", help="comma-separated folders of runs (<variant>_s<seed>/policy.pt and snapshots/)")
+    ap.add_argument("--reuse", help="comma-separated earlier results of this script whose runs are summarised too, not scored again")
     ap.add_argument("--json", default="results/snapshot_selection.json")
     ap.add_argument("--validation", choices=("levels", "scenarios"), default="levels",
                     help="what the rule sees: the training levels' random episodes, or other noisy episodes of the test's scenarios")
@@ -125,12 +151,23 @@ def main(argv: list[str] | None = None) -> dict:
     scenarios = args.scenarios.split(",")
     if args.validation == "scenarios" and args.validation_seed == args.seed:
         ap.error(f"--validation scenarios with --validation-seed {args.seed}, the test's --seed: the rule would see the test's episodes")
-    policies = run_policies(args.runs.split(","))
-    if not policies:
+    if not args.runs and not args.reuse:
+        ap.error("give --runs, --reuse or both")
+    validation = ({"levels": level_names(), "episodes_per_level": args.validation_episodes, "seed": args.validation_seed}
+                  if args.validation == "levels" else
+                  {"scenarios": scenarios, "episodes_per_scenario": args.validation_episodes, "seed": args.validation_seed})
+    test_episodes = {"scenarios": scenarios, "episodes_per_scenario": args.episodes, "seed": args.seed}
+    try:
+        runs = reused_runs(args.reuse.split(",") if args.reuse else [], validation, test_episodes)
+    except ValueError as e:
+        ap.error(str(e))
+    policies = run_policies(args.runs.split(",")) if args.runs else {}
+    if args.runs and not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}")
-    runs: dict[str, dict] = {}
     jobs_v, jobs_t = [], []
     for run, final in policies.items():
+        if run in runs:
+            continue
         final_s = float(load_policy(final).meta.get("extra", {}).get("wall_time_s", float("inf")))
         files = run_files(final.parent)
         if len(files) == 1:
@@ -150,11 +187,10 @@ def main(argv: list[str] | None = None) -> dict:
         run["selection"] = select(run, args.from_s)
     result = {
         "command": command_line("snapshot_selection.py", argv),
-        "validation": ({"levels": level_names(), "episodes_per_level": args.validation_episodes, "seed": args.validation_seed}
-                       if args.validation == "levels" else
-                       {"scenarios": scenarios, "episodes_per_scenario": args.validation_episodes, "seed": args.validation_seed}),
-        "test": {"scenarios": scenarios, "episodes_per_scenario": args.episodes, "seed": args.seed},
+        "validation": validation,
+        "test": test_episodes,
         "from_s": args.from_s,
+        "reused": args.reuse.split(",") if args.reuse else [],
         "chosen_minus_final": over_runs([r["selection"]["chosen_minus_final"] for r in runs.values()]),
         "runs": runs,
     }

@@ -120,3 +120,41 @@ def test_the_rule_can_see_other_episodes_of_the_test_scenarios_but_never_the_tes
               "--validation-seed", "0", "--seed", "0"])
     assert "the rule would see the test's episodes" in capsys.readouterr().err
     assert not (tmp_path / "same.json").exists()
+
+
+def test_runs_scored_earlier_are_summarised_with_new_ones_without_scoring_them_again(tmp_path, capsys):
+    settings = ["--validation", "scenarios", "--validation-episodes", "1", "--validation-seed", "7",
+                "--scenarios", "straight_ahead", "--episodes", "1"]
+    first = _run_with_a_bad_snapshot(tmp_path / "runs")
+    earlier = main(["--runs", str(tmp_path / "runs"), "--json", str(tmp_path / "first.json")] + settings)
+    for f in [first / "policy.pt", *(first / "snapshots").glob("*.pt")]:
+        f.write_bytes(b"not a checkpoint")  # scoring the first run again would fail on these
+    shutil.copytree(first, tmp_path / "runs" / "LBGP-test_s1")
+    second = tmp_path / "runs" / "LBGP-test_s1"
+    for f in [second / "policy.pt", second / "snapshots" / "policy_000200s.pt"]:
+        shutil.copy(SHIPPED, f)
+    shutil.copy(SHIPPED, second / "snapshots" / "policy_000100s.pt")
+    both = main(["--runs", str(tmp_path / "runs"), "--reuse", str(tmp_path / "first.json"),
+                 "--json", str(tmp_path / "both.json")] + settings)
+    assert list(both["runs"]) == ["LBGP-test_s0", "LBGP-test_s1"] and both["reused"] == [str(tmp_path / "first.json")]
+    assert both["runs"]["LBGP-test_s0"]["policies"] == earlier["runs"]["LBGP-test_s0"]["policies"]
+    assert both["runs"]["LBGP-test_s1"]["policies"]["000100s"]["test"] == earlier["runs"]["LBGP-test_s0"]["policies"]["final"]["test"]
+    assert len(both["chosen_minus_final"]["per_run"]) == 2 and both["chosen_minus_final"]["ci95_half_width"] is not None
+    # only the reused file, chosen again from a later wall time: no run folder needed
+    later = main(["--reuse", str(tmp_path / "both.json"), "--from-s", "150", "--json", str(tmp_path / "later.json")] + settings)
+    assert later["runs"]["LBGP-test_s0"]["selection"]["chosen"] in ("000200s", "final")
+    # scored on other episodes: refused, nothing written
+    with pytest.raises(SystemExit):
+        main(["--reuse", str(tmp_path / "first.json"), "--json", str(tmp_path / "other.json")] + settings[:-1] + ["2"])
+    assert "other test episodes" in capsys.readouterr().err and not (tmp_path / "other.json").exists()
+    with pytest.raises(SystemExit):
+        main(["--json", str(tmp_path / "none.json")] + settings)
+    assert "give --runs, --reuse or both" in capsys.readouterr().err
+
+
+def test_rank_correlation_is_none_where_it_is_undefined():
+    from snapshot_selection import spearman
+
+    assert spearman([1.0, 2.0], [2.0, 1.0]) is None  # too few
+    assert spearman([1.0, 1.0, 1.0], [1.0, 2.0, 3.0]) is None  # constant: no ranking
+    assert spearman([1.0, 2.0, 3.0], [3.0, 2.0, 1.0]) == -1.0

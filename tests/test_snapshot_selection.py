@@ -129,11 +129,9 @@ def test_runs_scored_earlier_are_summarised_with_new_ones_without_scoring_them_a
     earlier = main(["--runs", str(tmp_path / "runs"), "--json", str(tmp_path / "first.json")] + settings)
     for f in [first / "policy.pt", *(first / "snapshots").glob("*.pt")]:
         f.write_bytes(b"not a checkpoint")  # scoring the first run again would fail on these
-    shutil.copytree(first, tmp_path / "runs" / "LBGP-test_s1")
-    second = tmp_path / "runs" / "LBGP-test_s1"
-    for f in [second / "policy.pt", second / "snapshots" / "policy_000200s.pt"]:
+    second = shutil.copytree(first, tmp_path / "runs" / "LBGP-test_s1")  # a second run: the shipped policy throughout
+    for f in [second / "policy.pt", *(second / "snapshots").glob("*.pt")]:
         shutil.copy(SHIPPED, f)
-    shutil.copy(SHIPPED, second / "snapshots" / "policy_000100s.pt")
     both = main(["--runs", str(tmp_path / "runs"), "--reuse", str(tmp_path / "first.json"),
                  "--json", str(tmp_path / "both.json")] + settings)
     assert list(both["runs"]) == ["LBGP-test_s0", "LBGP-test_s1"] and both["reused"] == [str(tmp_path / "first.json")]
@@ -141,8 +139,10 @@ def test_runs_scored_earlier_are_summarised_with_new_ones_without_scoring_them_a
     assert both["runs"]["LBGP-test_s1"]["policies"]["000100s"]["test"] == earlier["runs"]["LBGP-test_s0"]["policies"]["final"]["test"]
     assert len(both["chosen_minus_final"]["per_run"]) == 2 and both["chosen_minus_final"]["ci95_half_width"] is not None
     # only the reused file, chosen again from a later wall time: no run folder needed
+    shutil.rmtree(tmp_path / "runs")
     later = main(["--reuse", str(tmp_path / "both.json"), "--from-s", "150", "--json", str(tmp_path / "later.json")] + settings)
     assert later["runs"]["LBGP-test_s0"]["selection"]["chosen"] in ("000200s", "final")
+    assert all(later["runs"][r]["policies"] == both["runs"][r]["policies"] for r in both["runs"])
     # scored on other episodes: refused, nothing written
     with pytest.raises(SystemExit):
         main(["--reuse", str(tmp_path / "first.json"), "--json", str(tmp_path / "other.json")] + settings[:-1] + ["2"])

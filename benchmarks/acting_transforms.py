@@ -1,7 +1,9 @@
-"""A trained LBGP policy acting through a transform of its goals: a gain on its residual, a lead on its goal.
+"""A trained LBGP policy acting through a transform of its goals: a gain on its residual, a lead on its goal, input smoothing.
 
     python benchmarks/acting_transforms.py --gains 0.75,1,1.25,1.5 --leads 0.5 --seed 500 --jobs 2 \
         --json results/acting_transforms_seed500.json
+    python benchmarks/acting_transforms.py --input-noise 1,2 --copies 16 --seed 500 --jobs 2 \
+        --json results/input_smoothing_seed500.json
 
 Asks, without training, whether the shipped policy's goals are the right size and come at the right
 time. Each transform wraps the policy as a user gets it (``lbgp.policies.make_policy``: goal dead
@@ -13,6 +15,10 @@ band and mirror-averaged acting included) and changes only the goal it sends to 
   larger residual might pay.
 * ``lead b``: goal_t + b * (goal_t - goal_{t-1}), a first-order lead on the goal sequence (b = 0: the
   policy itself). The searched goals on trajectory_three move two to three steps before LBGP's.
+* ``--input-noise m --copies K``: the mean goal over K copies of the observation, each with extra
+  Gaussian noise of m times the observation noise (0.03 m, 0.03 rad; seeded, the same draws every
+  episode), the dead band once on the mean: the policy smoothed over its input (randomised
+  smoothing), which might steady its answer to the observation noise.
 
 Every variant and HC are scored on the same sim-table episodes as ``benchmarks/ablation_scenarios.py``
 scores runs (20 noisy episodes per scenario, Jackal, ``--seed``): use a seed other than the sim
@@ -33,11 +39,15 @@ from _common import command_line, write_result  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ablation_scenarios import sim_table_rewards  # noqa: E402
+import torch  # noqa: E402
+
 from lbgp.actions import action_from_goal, goal_from_action  # noqa: E402
+from lbgp.agent.policy import GOAL_DEADBAND_M, shrink_residual  # noqa: E402
 from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import default_policy_path, make_policy  # noqa: E402
+from lbgp.sim import observation as obs_lib  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
 
@@ -68,8 +78,46 @@ class TransformedGoalPolicy:
         return action_from_goal(sent).astype(np.float32)
 
 
+# one standard deviation of the observation noise, per entry of the scaled observation
+_OBSERVATION_NOISE = obs_lib.scale(np.tile([obs_lib.DEFAULT_NOISE_STD[0]] * 2 + [obs_lib.DEFAULT_NOISE_STD[1]], obs_lib.SIZE // 3))
+
+
+class InputSmoothedPolicy:
+    """A residual goal policy (``policy_file``, mirror-averaged as shipped) acting on its mean goal over
+    ``copies`` copies of the observation, each with extra Gaussian noise of ``multiple`` times the
+    observation noise (drawn from ``seed`` afresh at every ``reset``), the dead band once on the mean."""
+
+    control = "goal"
+
+    def __init__(self, policy_file, multiple: float, copies: int, seed: int = 12345, robot: str = "jackal"):
+        if not (np.isfinite(multiple) and multiple >= 0.0) or copies < 1:
+            raise ValueError(f"input smoothing needs a finite noise multiple >= 0 and copies >= 1, got {multiple!r}, {copies!r}")
+        self.policy = make_policy("lbgp", policy_file, robot=robot, goal_deadband=0.0)
+        if self.policy.actor.residual_scale <= 0:
+            raise ValueError("input smoothing applies the dead band around the base goal of a residual goal policy")
+        self.multiple, self.copies, self.seed = float(multiple), int(copies), int(seed)
+        self.reset()
+
+    def reset(self) -> None:
+        self._rng = np.random.default_rng(self.seed)
+        self.policy.reset()
+
+    @torch.no_grad()
+    def act(self, observation) -> np.ndarray:
+        obs = np.asarray(observation, np.float32)
+        noise = self._rng.standard_normal((self.copies, obs.size)).astype(np.float32)
+        copies = np.clip(obs + self.multiple * _OBSERVATION_NOISE * noise, -1.0, 1.0)
+        goal = np.mean([goal_from_action(self.policy.act(c)) for c in copies], axis=0)
+        base = self.policy.actor.base_action(torch.from_numpy(obs)[None])[0].numpy()
+        return shrink_residual(action_from_goal(goal).astype(np.float32), base, GOAL_DEADBAND_M)
+
+
 def variant_name(gain: float, lead: float) -> str:
     return f"gain{gain:g}_lead{lead:g}"
+
+
+def smoothing_name(multiple: float, copies: int) -> str:
+    return f"input_noise{multiple:g}_copies{copies}"
 
 
 def numbers(text: str, flag: str) -> list[float]:
@@ -83,13 +131,20 @@ def numbers(text: str, flag: str) -> list[float]:
 
 
 def score(job: tuple) -> tuple[str, dict]:
-    """job: (name, method, policy_file, gain, lead, scenarios, episodes, seed); method hc scores HC."""
-    name, method, policy_file, gain, lead, scenarios, episodes, seed = job
-    policy = make_policy(method, policy_file, robot="jackal")
-    if method == "lbgp":
-        policy = TransformedGoalPolicy(policy, gain, lead)
+    """job: (name, method, policy_file, gain, lead, scenarios, episodes, seed[, (noise multiple, copies)]);
+    method hc scores HC."""
+    name, method, policy_file, gain, lead, scenarios, episodes, seed, *smoothing = job
+    if smoothing:
+        policy = InputSmoothedPolicy(policy_file, *smoothing[0])
+    else:
+        policy = make_policy(method, policy_file, robot="jackal")
+        if method == "lbgp":
+            policy = TransformedGoalPolicy(policy, gain, lead)
     per_scenario = sim_table_rewards(policy, method, scenarios, episodes, seed, planner_config_for("jackal", None))
-    return name, {"gain": gain, "lead": lead, "per_scenario": per_scenario, "sum": round(sum(per_scenario.values()), 3)}
+    row = {"gain": gain, "lead": lead, "per_scenario": per_scenario, "sum": round(sum(per_scenario.values()), 3)}
+    if smoothing:
+        row["input_noise"], row["copies"] = smoothing[0]
+    return name, row
 
 
 def rows_minus(per_scenario: dict, hc: dict, rows) -> float | None:
@@ -102,6 +157,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--policy", help="an LBGP policy file (default: the shipped Jackal policy)")
     ap.add_argument("--gains", default="1", help="comma-separated gains on the residual (1: none)")
     ap.add_argument("--leads", default="0", help="comma-separated leads on the goal sequence (0: none)")
+    ap.add_argument("--input-noise", default="", metavar="M",
+                    help="comma-separated multiples of the observation noise: act on the mean goal over --copies noisy copies")
+    ap.add_argument("--copies", type=int, default=16, help="observation copies per step with --input-noise (default 16)")
     ap.add_argument("--scenarios", default=",".join(scenario_names()), help="comma-separated (default: the 9 paper scenarios)")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
@@ -109,6 +167,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--json", default="results/acting_transforms.json")
     args = ap.parse_args(argv)
     gains, leads = numbers(args.gains, "--gains"), numbers(args.leads, "--leads")
+    multiples = numbers(args.input_noise, "--input-noise") if args.input_noise else []
+    if any(m < 0 for m in multiples) or args.copies < 1:
+        ap.error(f"--input-noise takes multiples >= 0 and --copies at least 1, got {args.input_noise!r} and {args.copies}")
     scenarios = args.scenarios.split(",")
     unknown = sorted(set(scenarios) - set(scenario_names()))
     if unknown:
@@ -120,6 +181,8 @@ def main(argv: list[str] | None = None) -> dict:
     pairs = dict.fromkeys([(1.0, 0.0)] + [(g, 0.0) for g in gains] + [(1.0, b) for b in leads])
     jobs = [("HC", "hc", None, 1.0, 0.0, scenarios, args.episodes, args.seed)]
     jobs += [(variant_name(g, b), "lbgp", policy_file, g, b, scenarios, args.episodes, args.seed) for g, b in pairs]
+    jobs += [(smoothing_name(m, args.copies), "lbgp", policy_file, 1.0, 0.0, scenarios, args.episodes, args.seed, (m, args.copies))
+             for m in dict.fromkeys(multiples)]
     with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))
     hc = scored.pop("HC")["per_scenario"]

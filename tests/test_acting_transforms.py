@@ -1,5 +1,6 @@
-"""benchmarks/acting_transforms.py: a trained goal policy acting through a gain on its residual or a
-lead on its goal sequence, and Policy.base_goal that the gain scales around."""
+"""benchmarks/acting_transforms.py: a trained goal policy acting through a gain on its residual, a
+lead on its goal sequence or smoothed over noisy copies of its input, and Policy.base_goal that the
+gain scales around."""
 
 import math
 import sys
@@ -11,14 +12,14 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from acting_transforms import TransformedGoalPolicy, main, variant_name  # noqa: E402
+from acting_transforms import InputSmoothedPolicy, TransformedGoalPolicy, main, smoothing_name, variant_name  # noqa: E402
 from ablation_scenarios import scenario_seed  # noqa: E402
 
 from lbgp.actions import DESIRED_GOAL, action_from_goal, goal_from_action  # noqa: E402
 from lbgp.agent.config import D4PGConfig  # noqa: E402
 from lbgp.agent.learner import make_actor  # noqa: E402
 from lbgp.agent.networks import Actor  # noqa: E402
-from lbgp.agent.policy import load_policy, save_policy  # noqa: E402
+from lbgp.agent.policy import GOAL_DEADBAND_M, load_policy, save_policy, shrink_residual  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import observation as obs_lib  # noqa: E402
@@ -107,3 +108,58 @@ def test_the_benchmark_scores_the_untransformed_policy_as_the_shipped_one_and_na
     with pytest.raises(SystemExit):
         main(["--scenarios", "nowhere", "--json", str(tmp_path / "b.json")])
     assert not (tmp_path / "b.json").exists()
+
+
+def _observations(n):
+    """A few real observations of the shipped policy's Jackal on turning_ahead, with the observation noise on."""
+    from lbgp.sim import make_env
+
+    env = make_env("turning_ahead", robot="jackal", seed=3, obs_noise=True)
+    step, policy, out = env.reset(), make_policy("lbgp", robot="jackal"), []
+    for _ in range(n):
+        out.append(np.asarray(step.observation, np.float32))
+        step = env.step(policy.act(step.observation))
+    return out
+
+
+def test_input_smoothing_without_noise_is_the_policy_and_with_noise_the_mean_over_seeded_copies():
+    observations = _observations(6)
+    shipped = make_policy("lbgp", robot="jackal")
+    one = InputSmoothedPolicy(None, 0.0, 1)
+    for obs in observations:  # one noiseless copy, the dead band once: exactly the policy as shipped
+        assert np.array_equal(one.act(obs), shipped.act(obs))
+    smoothed = InputSmoothedPolicy(None, 2.0, 4, seed=9)
+    sent = [smoothed.act(obs) for obs in observations]
+    # the same by hand: the seeded draws, the mean goal of the undamped policy, the dead band on it
+    plain, rng = make_policy("lbgp", robot="jackal", goal_deadband=0.0), np.random.default_rng(9)
+    std = obs_lib.scale(np.tile([0.03, 0.03, 0.03], obs_lib.SIZE // 3))
+    for obs, got in zip(observations, sent):
+        copies = np.clip(obs + 2.0 * std * rng.standard_normal((4, obs.size)).astype(np.float32), -1.0, 1.0)
+        goal = np.mean([goal_from_action(plain.act(c)) for c in copies], axis=0)
+        base = plain.actor.base_action(torch.from_numpy(obs)[None])[0].numpy()
+        assert np.allclose(got, shrink_residual(action_from_goal(goal).astype(np.float32), base, GOAL_DEADBAND_M), atol=1e-6)
+    assert not all(np.array_equal(a, shipped.act(o)) for a, o in zip(sent, observations))  # the noise does move the goal
+    smoothed.reset()  # the same draws again, episode after episode
+    assert all(np.array_equal(smoothed.act(o), a) for o, a in zip(observations, sent))
+
+
+def test_input_smoothing_names_bad_settings(tmp_path):
+    with pytest.raises(ValueError, match="noise multiple"):
+        InputSmoothedPolicy(None, -1.0, 4)
+    with pytest.raises(ValueError, match="copies"):
+        InputSmoothedPolicy(None, 1.0, 0)
+    plain = Actor(obs_lib.SIZE, 2, (8,))
+    save_policy(tmp_path / "plain.pt", plain, "lbgp", "jackal", (8,))
+    with pytest.raises(ValueError, match="residual goal policy"):
+        InputSmoothedPolicy(tmp_path / "plain.pt", 1.0, 4)
+    with pytest.raises(SystemExit):
+        main(["--input-noise", "-1", "--json", str(tmp_path / "c.json")])
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_the_benchmark_scores_input_smoothing_beside_the_policy(tmp_path):
+    out = main(["--input-noise", "0", "--copies", "1", "--scenarios", "straight_ahead", "--episodes", "1", "--seed", "3",
+                "--json", str(tmp_path / "s.json")])
+    row = out["variants"][smoothing_name(0, 1)]
+    assert (row["input_noise"], row["copies"]) == (0.0, 1)
+    assert row["per_scenario"] == out["variants"][variant_name(1, 0)]["per_scenario"]  # no noise, one copy: the policy

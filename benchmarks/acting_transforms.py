@@ -37,10 +37,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
-
-from ablation_scenarios import sim_table_rewards  # noqa: E402
 import torch  # noqa: E402
 
+from ablation_scenarios import sim_table_rewards  # noqa: E402
 from lbgp.actions import action_from_goal, goal_from_action  # noqa: E402
 from lbgp.agent.policy import GOAL_DEADBAND_M, shrink_residual  # noqa: E402
 from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402

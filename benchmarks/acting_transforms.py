@@ -40,8 +40,9 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 from ablation_scenarios import sim_table_rewards  # noqa: E402
+from policy_ensemble import deadband_once  # noqa: E402
 from lbgp.actions import action_from_goal, goal_from_action  # noqa: E402
-from lbgp.agent.policy import GOAL_DEADBAND_M, shrink_residual  # noqa: E402
+from lbgp.agent.policy import GOAL_DEADBAND_M  # noqa: E402
 from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
@@ -107,8 +108,7 @@ class InputSmoothedPolicy:
         noise = self._rng.standard_normal((self.copies, obs.size)).astype(np.float32)
         copies = np.clip(obs + self.multiple * _OBSERVATION_NOISE * noise, -1.0, 1.0)
         goal = np.mean([goal_from_action(self.policy.act(c)) for c in copies], axis=0)
-        base = self.policy.actor.base_action(torch.from_numpy(obs)[None])[0].numpy()
-        return shrink_residual(action_from_goal(goal).astype(np.float32), base, GOAL_DEADBAND_M)
+        return deadband_once(self.policy, obs, goal, GOAL_DEADBAND_M)
 
 
 def variant_name(gain: float, lead: float) -> str:

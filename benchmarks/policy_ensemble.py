@@ -54,12 +54,19 @@ class EnsemblePolicy:
     @torch.no_grad()
     def act(self, observation) -> np.ndarray:
         goal = np.mean([goal_from_action(m.act(observation)) for m in self.members], axis=0)
-        action = action_from_goal(goal).astype(np.float32)
-        first = self.members[0]
-        if self.goal_deadband <= 0.0 or first.actor.residual_scale == 0:
-            return action
-        base = first.actor.base_action(torch.from_numpy(np.asarray(observation, np.float32))[None])[0].numpy()
-        return shrink_residual(action, base, self.goal_deadband)
+        return deadband_once(self.members[0], observation, goal, self.goal_deadband)
+
+
+@torch.no_grad()
+def deadband_once(policy, observation, goal, deadband_m: float) -> np.ndarray:
+    """The action of ``goal`` (person frame, m; a mean of goals sent without dead band) moved
+    ``deadband_m`` toward ``policy``'s base goal for ``observation`` (``shrink_residual``): the dead
+    band applied once, to the mean. Unchanged without a dead band or for a plain actor (no base)."""
+    action = action_from_goal(goal).astype(np.float32)
+    if deadband_m <= 0.0 or policy.actor.residual_scale == 0:
+        return action
+    base = policy.actor.base_action(torch.from_numpy(np.asarray(observation, np.float32))[None])[0].numpy()
+    return shrink_residual(action, base, deadband_m)
 
 
 def score(job: tuple) -> tuple[tuple, float]:

@@ -1,7 +1,10 @@
-"""A trained LBGP policy acting through a transform of its goals: a gain on its residual, a lead on its goal, input smoothing.
+"""A trained LBGP policy acting through a transform of its goals: a gain on its residual (all of it or
+its lateral part), a lead on its goal, input smoothing.
 
     python benchmarks/acting_transforms.py --gains 0.75,1,1.25,1.5 --leads 0.5 --seed 500 --jobs 2 \
         --json results/acting_transforms_seed500.json
+    python benchmarks/acting_transforms.py --lateral-gains 1.5,1.75,2 --seed 500 --jobs 2 \
+        --json results/lateral_gain_seed500.json
     python benchmarks/acting_transforms.py --input-noise 1,2 --copies 16 --seed 500 --jobs 2 \
         --json results/input_smoothing_seed500.json
 
@@ -13,6 +16,8 @@ band and mirror-averaged acting included) and changes only the goal it sends to 
   (k = 1: the policy itself). The goal prior pulls the residual toward zero in training, and the
   searched goals that react after a turn shows swing wider than LBGP's (docs/ceilings.md), so a
   larger residual might pay.
+* ``lateral gain k``: only the residual's lateral part (y, the person frame's left) scaled by k, its
+  part along the person's heading kept: the searched goals swing wider, not farther ahead.
 * ``lead b``: goal_t + b * (goal_t - goal_{t-1}), a first-order lead on the goal sequence (b = 0: the
   policy itself). The searched goals on trajectory_three move two to three steps before LBGP's.
 * ``--input-noise m --copies K``: the mean goal over K copies of the observation, each with extra
@@ -52,16 +57,18 @@ from lbgp.sim import scenario_names  # noqa: E402
 
 
 class TransformedGoalPolicy:
-    """``policy``'s goals with its residual scaled by ``gain`` and a lead ``lead`` on their sequence."""
+    """``policy``'s goals with its residual scaled by ``gain`` (its lateral part by ``gain * lateral_gain``)
+    and a lead ``lead`` on their sequence."""
 
     control = "goal"
 
-    def __init__(self, policy, gain: float = 1.0, lead: float = 0.0):
+    def __init__(self, policy, gain: float = 1.0, lead: float = 0.0, lateral_gain: float = 1.0):
         if getattr(policy, "control", None) != "goal":
             raise ValueError("acting transforms change a goal policy's goals; this policy sends velocities")
-        if not (np.isfinite(gain) and np.isfinite(lead)):
-            raise ValueError(f"gain and lead must be finite, got {gain!r} and {lead!r}")
+        if not (np.isfinite(gain) and np.isfinite(lead) and np.isfinite(lateral_gain)):
+            raise ValueError(f"gains and lead must be finite, got {gain!r}, {lateral_gain!r} and {lead!r}")
         self.policy, self.gain, self.lead = policy, float(gain), float(lead)
+        self.scale = np.array([1.0, float(lateral_gain)]) * self.gain  # on the residual's (x, y)
         self._previous = None
 
     def reset(self) -> None:
@@ -69,10 +76,11 @@ class TransformedGoalPolicy:
         self.policy.reset()
 
     def act(self, observation) -> np.ndarray:
-        base = self.policy.base_goal(observation) if self.gain != 1.0 else None  # before act: it reads the previous goal
+        scaled = bool(np.any(self.scale != 1.0))
+        base = self.policy.base_goal(observation) if scaled else None  # before act: it reads the previous goal
         goal = goal_from_action(self.policy.act(observation))
         if base is not None:
-            goal = base + self.gain * (goal - base)
+            goal = base + self.scale * (goal - base)
         sent = goal if self._previous is None else goal + self.lead * (goal - self._previous)
         self._previous = goal
         return action_from_goal(sent).astype(np.float32)
@@ -111,8 +119,8 @@ class InputSmoothedPolicy:
         return deadband_once(self.policy, obs, goal, GOAL_DEADBAND_M)
 
 
-def variant_name(gain: float, lead: float) -> str:
-    return f"gain{gain:g}_lead{lead:g}"
+def variant_name(gain: float, lead: float, lateral_gain: float = 1.0) -> str:
+    return f"gain{gain:g}_lead{lead:g}" + (f"_lateral{lateral_gain:g}" if lateral_gain != 1.0 else "")
 
 
 def smoothing_name(multiple: float, copies: int) -> str:
@@ -130,17 +138,19 @@ def numbers(text: str, flag: str) -> list[float]:
 
 
 def score(job: tuple) -> tuple[str, dict]:
-    """job: (name, method, policy_file, gain, lead, scenarios, episodes, seed[, (noise multiple, copies)]);
-    method hc scores HC."""
-    name, method, policy_file, gain, lead, scenarios, episodes, seed, *smoothing = job
+    """job: (name, method, policy_file, (gain, lead, lateral gain), scenarios, episodes, seed[, (noise multiple,
+    copies)]); method hc scores HC."""
+    name, method, policy_file, (gain, lead, lateral_gain), scenarios, episodes, seed, *smoothing = job
     if smoothing:
         policy = InputSmoothedPolicy(policy_file, *smoothing[0])
     else:
         policy = make_policy(method, policy_file, robot="jackal")
         if method == "lbgp":
-            policy = TransformedGoalPolicy(policy, gain, lead)
+            policy = TransformedGoalPolicy(policy, gain, lead, lateral_gain)
     per_scenario = sim_table_rewards(policy, method, scenarios, episodes, seed, planner_config_for("jackal", None))
     row = {"gain": gain, "lead": lead, "per_scenario": per_scenario, "sum": round(sum(per_scenario.values()), 3)}
+    if lateral_gain != 1.0:
+        row["lateral_gain"] = lateral_gain
     if smoothing:
         row["input_noise"], row["copies"] = smoothing[0]
     return name, row
@@ -156,6 +166,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--policy", help="an LBGP policy file (default: the shipped Jackal policy)")
     ap.add_argument("--gains", default="1", help="comma-separated gains on the residual (1: none)")
     ap.add_argument("--leads", default="0", help="comma-separated leads on the goal sequence (0: none)")
+    ap.add_argument("--lateral-gains", default="1", help="comma-separated gains on the residual's lateral part alone (1: none)")
     ap.add_argument("--input-noise", default="", metavar="M",
                     help="comma-separated multiples of the observation noise: act on the mean goal over --copies noisy copies")
     ap.add_argument("--copies", type=int, default=16, help="observation copies per step with --input-noise (default 16)")
@@ -166,6 +177,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--json", default="results/acting_transforms.json")
     args = ap.parse_args(argv)
     gains, leads = numbers(args.gains, "--gains"), numbers(args.leads, "--leads")
+    lateral_gains = numbers(args.lateral_gains, "--lateral-gains")
     multiples = numbers(args.input_noise, "--input-noise") if args.input_noise else []
     if any(m < 0 for m in multiples) or args.copies < 1:
         ap.error(f"--input-noise takes multiples >= 0 and --copies at least 1, got {args.input_noise!r} and {args.copies}")
@@ -176,11 +188,13 @@ def main(argv: list[str] | None = None) -> dict:
     if args.episodes < 1:
         ap.error(f"--episodes must be at least 1, got {args.episodes}")
     policy_file = args.policy or os.path.relpath(default_policy_path("lbgp", "jackal"))
-    # the policy itself (gain 1, lead 0) always; then each gain without lead and each lead without gain
-    pairs = dict.fromkeys([(1.0, 0.0)] + [(g, 0.0) for g in gains] + [(1.0, b) for b in leads])
-    jobs = [("HC", "hc", None, 1.0, 0.0, scenarios, args.episodes, args.seed)]
-    jobs += [(variant_name(g, b), "lbgp", policy_file, g, b, scenarios, args.episodes, args.seed) for g, b in pairs]
-    jobs += [(smoothing_name(m, args.copies), "lbgp", policy_file, 1.0, 0.0, scenarios, args.episodes, args.seed, (m, args.copies))
+    # the policy itself (gain 1, lead 0) always; then each gain, each lead and each lateral gain alone
+    transforms = dict.fromkeys([(1.0, 0.0, 1.0)] + [(g, 0.0, 1.0) for g in gains] + [(1.0, b, 1.0) for b in leads]
+                               + [(1.0, 0.0, k) for k in lateral_gains])
+    none = (1.0, 0.0, 1.0)
+    jobs = [("HC", "hc", None, none, scenarios, args.episodes, args.seed)]
+    jobs += [(variant_name(*t), "lbgp", policy_file, t, scenarios, args.episodes, args.seed) for t in transforms]
+    jobs += [(smoothing_name(m, args.copies), "lbgp", policy_file, none, scenarios, args.episodes, args.seed, (m, args.copies))
              for m in dict.fromkeys(multiples)]
     with process_pool(args.jobs) as pool:
         scored = dict(pool.map(score, jobs))

@@ -60,6 +60,17 @@ def test_a_gain_scales_the_residual_around_the_base_goal(tmp_path):
         assert np.allclose(sent, np.add(DESIRED_GOAL, expected), atol=1e-5), gain
 
 
+def test_a_lateral_gain_scales_only_the_residual_s_lateral_part(tmp_path):
+    obs = np.zeros(obs_lib.SIZE, np.float32)
+    policy = _constant_residual_policy(tmp_path, (0.3, 0.4))
+    for lateral, gain, expected in ((2.0, 1.0, [0.3, 0.8]), (0.5, 1.0, [0.3, 0.2]), (1.5, 2.0, [0.6, 1.2])):
+        sent = goal_from_action(TransformedGoalPolicy(policy, gain=gain, lateral_gain=lateral).act(obs))
+        assert np.allclose(sent, np.add(DESIRED_GOAL, expected), atol=1e-5), (lateral, gain)
+    assert variant_name(1, 0, 1.5) == "gain1_lead0_lateral1.5" and variant_name(1.5, 0) == "gain1.5_lead0"
+    with pytest.raises(ValueError, match="finite"):
+        TransformedGoalPolicy(policy, lateral_gain=float("inf"))
+
+
 def test_a_gain_scales_around_a_turn_aware_base_not_the_goal_ahead(tmp_path):
     from test_goal_policy import _turning_observation
 
@@ -105,6 +116,8 @@ def test_the_benchmark_scores_the_untransformed_policy_as_the_shipped_one_and_na
     assert (tmp_path / "a.json").is_file()
     with pytest.raises(SystemExit, match="--gains"):
         main(["--gains", "1,x", "--json", str(tmp_path / "b.json")])
+    with pytest.raises(SystemExit, match="--lateral-gains"):
+        main(["--lateral-gains", "nan", "--json", str(tmp_path / "b.json")])
     with pytest.raises(SystemExit):
         main(["--scenarios", "nowhere", "--json", str(tmp_path / "b.json")])
     assert not (tmp_path / "b.json").exists()

@@ -3,7 +3,7 @@ its lateral part), a lead on its goal, input smoothing.
 
     python benchmarks/acting_transforms.py --gains 0.75,1,1.25,1.5 --leads 0.5 --seed 500 --jobs 2 \
         --json results/acting_transforms_seed500.json
-    python benchmarks/acting_transforms.py --lateral-gains 1.5,1.75,2 --seed 500 --jobs 2 \
+    python benchmarks/acting_transforms.py --lateral-gains 1.25,1.5,1.75,2 --seed 500 --jobs 2 \
         --json results/lateral_gain_seed500.json
     python benchmarks/acting_transforms.py --input-noise 1,2 --copies 16 --seed 500 --jobs 2 \
         --json results/input_smoothing_seed500.json

@@ -69,6 +69,7 @@ class TransformedGoalPolicy:
             raise ValueError(f"gains and lead must be finite, got {gain!r}, {lateral_gain!r} and {lead!r}")
         self.policy, self.gain, self.lead = policy, float(gain), float(lead)
         self.scale = np.array([1.0, float(lateral_gain)]) * self.gain  # on the residual's (x, y)
+        self._scaled = bool(np.any(self.scale != 1.0))
         self._previous = None
 
     def reset(self) -> None:
@@ -76,8 +77,7 @@ class TransformedGoalPolicy:
         self.policy.reset()
 
     def act(self, observation) -> np.ndarray:
-        scaled = bool(np.any(self.scale != 1.0))
-        base = self.policy.base_goal(observation) if scaled else None  # before act: it reads the previous goal
+        base = self.policy.base_goal(observation) if self._scaled else None  # before act: it reads the previous goal
         goal = goal_from_action(self.policy.act(observation))
         if base is not None:
             goal = base + self.scale * (goal - base)
@@ -189,9 +189,9 @@ def main(argv: list[str] | None = None) -> dict:
         ap.error(f"--episodes must be at least 1, got {args.episodes}")
     policy_file = args.policy or os.path.relpath(default_policy_path("lbgp", "jackal"))
     # the policy itself (gain 1, lead 0) always; then each gain, each lead and each lateral gain alone
-    transforms = dict.fromkeys([(1.0, 0.0, 1.0)] + [(g, 0.0, 1.0) for g in gains] + [(1.0, b, 1.0) for b in leads]
-                               + [(1.0, 0.0, k) for k in lateral_gains])
     none = (1.0, 0.0, 1.0)
+    transforms = dict.fromkeys([none] + [(g, 0.0, 1.0) for g in gains] + [(1.0, b, 1.0) for b in leads]
+                               + [(1.0, 0.0, k) for k in lateral_gains])
     jobs = [("HC", "hc", None, none, scenarios, args.episodes, args.seed)]
     jobs += [(variant_name(*t), "lbgp", policy_file, t, scenarios, args.episodes, args.seed) for t in transforms]
     jobs += [(smoothing_name(m, args.copies), "lbgp", policy_file, none, scenarios, args.episodes, args.seed, (m, args.copies))

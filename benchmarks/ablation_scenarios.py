@@ -39,7 +39,11 @@ training runs): whether one run's lead over another is more than the episodes' l
 ``--planner-sqp-iterations K`` scores every policy and HC on the planner with that SQP cap per band
 (runs trained with ``lbgp train --set planner_sqp_iterations=K``); E2E drives no planner. Without it
 every method drives the preset, even a policy whose file names another planner (``lbgp evaluate``
-would honour the file), so that all are compared on one planner.
+would honour the file), so that all are compared on one planner. ``--planner-changes
+max_vel_x=2.0`` (NAME=VALUE pairs as ``lbgp train --set train_planner_changes`` takes them,
+``lbgp.planner.config.changes_from_text``) likewise scores every planner-driven method, HC too, on
+the Jackal's preset with those settings changed: e.g. a faster planner for policies trained on
+the preset, or for runs trained with those settings.
 """
 
 from __future__ import annotations
@@ -61,6 +65,7 @@ from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.experiments.tables import paired_lead  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
@@ -131,6 +136,15 @@ def sqp_cap(text: str) -> int:
     """``--planner-sqp-iterations``: checked as ``lbgp train --set planner_sqp_iterations`` checks it."""
     try:
         return D4PGConfig.parse_setting(f"planner_sqp_iterations={text}")[1]
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def planner_changes_arg(text: str) -> dict:
+    """``--planner-changes``: NAME=VALUE pairs of ``PlannerConfig`` fields, checked as ``lbgp train``
+    checks ``train_planner_changes``; the problem named otherwise."""
+    try:
+        return changes_from_text(text)
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
 
@@ -248,6 +262,9 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--planner-sqp-iterations", type=sqp_cap, default=0,
                     help="score every planner-driven method (HC too) with this SQP cap per band (0: the preset; "
                          "for runs trained with --set planner_sqp_iterations=K)")
+    ap.add_argument("--planner-changes", type=planner_changes_arg, default={}, metavar="NAME=VALUE[,...]",
+                    help="score every planner-driven method (HC too) on the preset with these settings changed, "
+                         "e.g. max_vel_x=2.0 (default: none)")
     ap.add_argument("--deadbands", default=str(GOAL_DEADBAND_M), help="comma-separated goal dead bands (m) for the LBGP runs")
     ap.add_argument("--mirror", default="on" if MIRROR_AVERAGE else "off",
                     help="comma-separated on/off: score every run with and/or without mirror-averaged acting")
@@ -276,6 +293,9 @@ def main(argv: list[str] | None = None) -> dict:
     if not policies:
         sys.exit(f"no <run>/policy.pt under {args.runs}: run `lbgp experiment ablation` first")
     planner = D4PGConfig(planner_sqp_iterations=args.planner_sqp_iterations).planner_changes()
+    if "sqp_iterations" in args.planner_changes and planner:
+        ap.error("--planner-changes sets sqp_iterations, which --planner-sqp-iterations sets too: give it once")
+    planner = {**planner, **args.planner_changes}
     jobs = [("HC", "hc", None, scenarios, args.episodes, args.seed, None, None, planner)]
     for name, path in policies.items():
         e2e = variant_of(name) == "E2E"

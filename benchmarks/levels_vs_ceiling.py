@@ -11,6 +11,10 @@ on the file's finest grid; the share of the bound at the planner's speed (1.5 m/
 here exceeds: the planner's limit, E2E's 1 m/s) is given beside it. Target (goal-policy issue):
 LBGP >= 60 %.
 
+``--planner-changes max_vel_x=2.0`` (NAME=VALUE pairs, ``lbgp.planner.config.changes_from_text``)
+scores every planner-driven method on the Jackal's preset with those settings changed (and the
+"planner's speed" ceiling follows its ``max_vel_x``).
+
 Per level and method also the episodes that start in front of the person (|alpha| < 90 deg) and
 behind, apart: their mean returns, counts and shares of the ceiling's front-half and back-half
 bounds (where a level's score is lost).
@@ -30,6 +34,7 @@ import numpy as np  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import level_names  # noqa: E402
 
@@ -73,10 +78,14 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--vmax", type=float, default=TOP_SPEED_VMAX, help="the ceilings' top speed, m/s (default: the Jackal's, 2.0)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--lbgp-policy", default=None, help="LBGP policy file (default: the shipped one)")
+    ap.add_argument("--planner-changes", default="", metavar="NAME=VALUE[,...]",
+                    help="every planner-driven method drives the Jackal preset with these settings changed, e.g. max_vel_x=2.0")
     args = ap.parse_args(argv)
     try:
+        changes = changes_from_text(args.planner_changes)
+        planner = planner_config_for("jackal", changes) if changes else None
         bounds = level_ceilings(args.ceiling, args.vmax)
-        planner_vmax = planner_config_for("jackal").max_vel_x
+        planner_vmax = planner_config_for("jackal", changes).max_vel_x
         planner_bounds = level_ceilings(args.ceiling, planner_vmax)
     except ValueError as exc:
         ap.error(str(exc))
@@ -84,13 +93,15 @@ def main(argv: list[str] | None = None) -> dict:
     ceilings = {name: bounds[name]["mean_bound"] for name in levels}
     command = command_line("levels_vs_ceiling.py", argv)
     out = {"command": command, "episodes": args.episodes, "ceiling_vmax": args.vmax, "ceilings": ceilings,
-           "planner_vmax": planner_vmax, "planner_speed_ceilings": {name: planner_bounds[name]["mean_bound"] for name in levels},
+           "planner_changes": changes, "planner_vmax": planner_vmax,
+           "planner_speed_ceilings": {name: planner_bounds[name]["mean_bound"] for name in levels},
            "methods": {}}
     for method in args.methods.split(","):
         policy_file = args.lbgp_policy if method == "lbgp" else None
         policy = make_policy(method, policy_file=policy_file, robot="jackal")
         sides = StartSides()
-        rows = evaluate(policy, method, levels, robot="jackal", episodes=args.episodes, seed=args.seed, recorder=sides)
+        rows = evaluate(policy, method, levels, robot="jackal", episodes=args.episodes, seed=args.seed, recorder=sides,
+                        planner_config=planner)
         behind = dict(zip(levels, np.array(sides.behind).reshape(len(levels), args.episodes)))
         out["methods"][method] = {
             r["scenario"]: {"mean_return": round(r["reward"], 3), "ci95": round(r.get("reward_ci95", 0.0), 3),

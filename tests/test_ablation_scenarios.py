@@ -132,6 +132,32 @@ def test_a_planner_cap_scores_hc_and_the_policies_on_that_planner(tmp_path):
     assert not (tmp_path / "bad.json").exists()
 
 
+def test_planner_changes_score_hc_and_the_policies_on_the_changed_planner(tmp_path, capsys):
+    """--planner-changes max_vel_x=2.0: HC and every policy face the same episodes on the preset with
+    that setting changed; a setting the planner does not have, or the SQP cap given twice, is
+    refused by name with nothing written."""
+    from lbgp.planner import planner_config_for
+
+    runs = tmp_path / "runs"
+    (runs / "LBGP_s0").mkdir(parents=True)
+    shutil.copy(default_policy_path("lbgp"), runs / "LBGP_s0" / "policy.pt")
+    args = ["--runs", str(runs), "--scenarios", "straight_behind", "--episodes", "1"]
+    faster = main(args + ["--planner-changes", "max_vel_x=2.0", "--json", str(tmp_path / "fast.json")])
+    preset = main(args + ["--json", str(tmp_path / "preset.json")])
+    (hc,) = evaluate(make_policy("hc"), "hc", ["straight_behind"], episodes=1, seed=scenario_seed(0, "straight_behind"),
+                     obs_noise=True, planner_config=planner_config_for("jackal").with_(max_vel_x=2.0))
+    assert faster["planner_changes"] == {"max_vel_x": 2.0}
+    assert faster["hc"]["sum"] == pytest.approx(hc["reward"], abs=1e-3)
+    assert faster["hc"]["sum"] != preset["hc"]["sum"]  # from behind, the faster robot gets in front sooner
+    assert faster["runs"]["LBGP_s0"]["sum"] != preset["runs"]["LBGP_s0"]["sum"]
+    for bad, named in ((["--planner-changes", "max_speed=2"], "max_speed"),
+                       (["--planner-changes", "sqp_iterations=2", "--planner-sqp-iterations", "1"], "sqp_iterations")):
+        with pytest.raises(SystemExit) as exit_info:
+            main(args + bad + ["--json", str(tmp_path / "bad.json")])
+        assert exit_info.value.code == 2 and named in capsys.readouterr().err
+    assert not (tmp_path / "bad.json").exists()
+
+
 def test_two_runs_are_compared_on_the_same_episodes_with_a_paired_interval():
     from ablation_scenarios import paired_comparisons, paired_sum_difference
 

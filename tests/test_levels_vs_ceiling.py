@@ -38,6 +38,31 @@ def test_a_candidate_lbgp_policy_is_scored_on_the_same_seeded_level_episodes(tmp
     assert any(abs(rows[k]["mean_return"] - shipped[k]["mean_return"]) > 1e-3 for k in rows)
 
 
+def test_planner_changes_drive_every_method_on_the_changed_planner(tmp_path, capsys):
+    """--planner-changes max_vel_x=2.0: the methods play the same episodes on the faster planner, and
+    the planner-speed ceiling is read at its speed; an unknown setting is refused with nothing written."""
+    from lbgp.planner import planner_config_for
+    from _common import level_ceilings
+
+    args = ["--methods", "hc", "--episodes", "2", "--ceiling", CEILING]
+    faster = main(args + ["--planner-changes", "max_vel_x=2.0", "--json", str(tmp_path / "fast.json")])
+    preset = main(args + ["--json", str(tmp_path / "preset.json")])
+    expected = evaluate(make_policy("hc", robot="jackal"), "hc", level_names(), robot="jackal", episodes=2, seed=0,
+                        planner_config=planner_config_for("jackal").with_(max_vel_x=2.0))
+    rows = faster["methods"]["hc"]
+    for row in expected:
+        assert rows[row["scenario"]]["mean_return"] == pytest.approx(row["reward"], abs=1e-3)
+    assert any(abs(rows[k]["mean_return"] - preset["methods"]["hc"][k]["mean_return"]) > 1e-3 for k in rows)
+    assert faster["planner_changes"] == {"max_vel_x": 2.0} and faster["planner_vmax"] == 2.0
+    assert preset["planner_vmax"] == planner_config_for("jackal").max_vel_x
+    at_two = level_ceilings(CEILING, 2.0)
+    assert faster["planner_speed_ceilings"] == {k: at_two[k]["mean_bound"] for k in rows}
+    with pytest.raises(SystemExit) as exit_info:
+        main(args + ["--planner-changes", "top_speed=2", "--json", str(tmp_path / "bad.json")])
+    assert exit_info.value.code == 2 and "top_speed" in capsys.readouterr().err
+    assert not (tmp_path / "bad.json").exists()
+
+
 def test_start_sides_match_the_evaluated_episodes_and_split_their_returns():
     from levels_vs_ceiling import StartSides, by_start
 

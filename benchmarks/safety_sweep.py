@@ -6,6 +6,8 @@ The paper's 9 scenarios (Jackal), observation noise on, episodes spread evenly o
 its own seed, as `lbgp experiment sim` seeds them). Counts robot-person contacts and loops
 (``lbgp.metrics.LoopDetector``: the robot's heading turning through > 180 deg while its goal stays
 ahead of the person). Target (goal-policy issue): 0 contacts and 0 loops in 1,000 episodes.
+``--planner-changes max_vel_x=2.0`` (NAME=VALUE pairs, ``lbgp.planner.config.changes_from_text``):
+a planner-driven method drives the Jackal preset with those settings changed.
 """
 
 from __future__ import annotations
@@ -19,33 +21,43 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
+from lbgp.planner import planner_config_for  # noqa: E402
+from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", default="results/safety_sweep.json")
     ap.add_argument("--episodes", type=int, default=1000, help="episodes in all, spread evenly over the scenarios")
     ap.add_argument("--method", default="lbgp", choices=["lbgp", "hc", "e2e"])
     ap.add_argument("--policy", help="policy file (default: the shipped one)")
     ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
+    ap.add_argument("--planner-changes", default="", metavar="NAME=VALUE[,...]",
+                    help="drive the Jackal preset with these settings changed, e.g. max_vel_x=2.0 (default: none)")
+    args = ap.parse_args(argv)
+    try:
+        changes = changes_from_text(args.planner_changes)
+    except ValueError as error:
+        ap.error(str(error))
     names = scenario_names()
     per = -(-args.episodes // len(names))
     policy = make_policy(args.method, args.policy, robot="jackal")
     t0 = time.perf_counter()
-    rows = evaluate(policy, args.method, names, robot="jackal", episodes=per, seed=args.seed, obs_noise=True)
+    rows = evaluate(policy, args.method, names, robot="jackal", episodes=per, seed=args.seed, obs_noise=True,
+                    planner_config=planner_config_for("jackal", changes) if changes else None)
     per_scenario = {r["scenario"]: {"episodes": per, "contacts": int(r["collisions"]), "loops": int(r.get("loops", 0)),
                                     "early_ends": int(r["terminated_early"]), "reward": round(r["reward"], 3)} for r in rows}
     result = {
-        "command": command_line("safety_sweep.py"),
-        "method": args.method, "policy": args.policy or "shipped", "episodes": per * len(names),
+        "command": command_line("safety_sweep.py", argv),
+        "method": args.method, "policy": args.policy or "shipped", "planner_changes": changes, "episodes": per * len(names),
         "contacts": sum(v["contacts"] for v in per_scenario.values()),
         "loops": sum(v["loops"] for v in per_scenario.values()),
         "per_scenario": per_scenario, "wall_time_s": round(time.perf_counter() - t0, 1),
     }
     write_result(args.json, result)
+    return result
 
 
 if __name__ == "__main__":

@@ -109,52 +109,42 @@ def test_last_actor_scores_a_policy_average_runs_last_actor_as_its_paired_contro
     assert paired["per_seed"] == [pytest.approx(last["sum"] - average["sum"], abs=2e-3)]
 
 
-def test_a_planner_cap_scores_hc_and_the_policies_on_that_planner(tmp_path):
-    """--planner-sqp-iterations K: every planner-driven method faces the same episodes on the planner
-    with that SQP cap (as evaluate with the preset changed), and the file says so."""
-    from lbgp.planner import planner_config_for
-
-    runs = tmp_path / "runs"
-    (runs / "LBGP-cap1_s0").mkdir(parents=True)
-    shutil.copy(default_policy_path("lbgp"), runs / "LBGP-cap1_s0" / "policy.pt")
-    args = ["--runs", str(runs), "--scenarios", "turning_inside", "--episodes", "1"]
-    capped = main(args + ["--planner-sqp-iterations", "1", "--json", str(tmp_path / "cap1.json")])
-    preset = main(args + ["--json", str(tmp_path / "preset.json")])
-    cap1 = planner_config_for("jackal").with_(sqp_iterations=1)
-    (hc,) = evaluate(make_policy("hc"), "hc", ["turning_inside"], episodes=1, seed=scenario_seed(0, "turning_inside"), obs_noise=True,
-                   planner_config=cap1)
-    assert capped["planner_changes"] == {"sqp_iterations": 1} and preset["planner_changes"] == {}
-    assert capped["hc"]["sum"] == pytest.approx(hc["reward"], abs=1e-3)
-    assert capped["hc"]["sum"] != preset["hc"]["sum"]
-    assert capped["runs"]["LBGP-cap1_s0"]["sum"] != preset["runs"]["LBGP-cap1_s0"]["sum"]
-    with pytest.raises(SystemExit):
-        main(args + ["--planner-sqp-iterations", "-1", "--json", str(tmp_path / "bad.json")])
-    assert not (tmp_path / "bad.json").exists()
-
-
-def test_planner_changes_score_hc_and_the_policies_on_the_changed_planner(tmp_path, capsys):
-    """--planner-changes max_vel_x=2.0: HC and every policy face the same episodes on the preset with
-    that setting changed; a setting the planner does not have, or the SQP cap given twice, is
-    refused by name with nothing written."""
+@pytest.mark.parametrize("flags, changes, scenario", [
+    (["--planner-sqp-iterations", "1"], {"sqp_iterations": 1}, "turning_inside"),
+    (["--planner-changes", "max_vel_x=2.0"], {"max_vel_x": 2.0}, "straight_behind"),  # from behind, faster gets in front sooner
+])
+def test_a_planner_change_scores_hc_and_the_policies_on_that_planner(tmp_path, flags, changes, scenario):
+    """--planner-sqp-iterations K or --planner-changes NAME=VALUE: every planner-driven method faces
+    the same episodes on the preset with that change (as evaluate with the preset changed), and the
+    file says so."""
     from lbgp.planner import planner_config_for
 
     runs = tmp_path / "runs"
     (runs / "LBGP_s0").mkdir(parents=True)
     shutil.copy(default_policy_path("lbgp"), runs / "LBGP_s0" / "policy.pt")
-    args = ["--runs", str(runs), "--scenarios", "straight_behind", "--episodes", "1"]
-    faster = main(args + ["--planner-changes", "max_vel_x=2.0", "--json", str(tmp_path / "fast.json")])
+    args = ["--runs", str(runs), "--scenarios", scenario, "--episodes", "1"]
+    changed = main(args + flags + ["--json", str(tmp_path / "changed.json")])
     preset = main(args + ["--json", str(tmp_path / "preset.json")])
-    (hc,) = evaluate(make_policy("hc"), "hc", ["straight_behind"], episodes=1, seed=scenario_seed(0, "straight_behind"),
-                     obs_noise=True, planner_config=planner_config_for("jackal").with_(max_vel_x=2.0))
-    assert faster["planner_changes"] == {"max_vel_x": 2.0}
-    assert faster["hc"]["sum"] == pytest.approx(hc["reward"], abs=1e-3)
-    assert faster["hc"]["sum"] != preset["hc"]["sum"]  # from behind, the faster robot gets in front sooner
-    assert faster["runs"]["LBGP_s0"]["sum"] != preset["runs"]["LBGP_s0"]["sum"]
-    for bad, named in ((["--planner-changes", "max_speed=2"], "max_speed"),
-                       (["--planner-changes", "sqp_iterations=2", "--planner-sqp-iterations", "1"], "sqp_iterations")):
-        with pytest.raises(SystemExit) as exit_info:
-            main(args + bad + ["--json", str(tmp_path / "bad.json")])
-        assert exit_info.value.code == 2 and named in capsys.readouterr().err
+    (hc,) = evaluate(make_policy("hc"), "hc", [scenario], episodes=1, seed=scenario_seed(0, scenario), obs_noise=True,
+                     planner_config=planner_config_for("jackal").with_(**changes))
+    assert changed["planner_changes"] == changes and preset["planner_changes"] == {}
+    assert changed["hc"]["sum"] == pytest.approx(hc["reward"], abs=1e-3)
+    assert changed["hc"]["sum"] != preset["hc"]["sum"]
+    assert changed["runs"]["LBGP_s0"]["sum"] != preset["runs"]["LBGP_s0"]["sum"]
+
+
+@pytest.mark.parametrize("flags, named", [
+    (["--planner-sqp-iterations", "-1"], "planner_sqp_iterations"),
+    (["--planner-changes", "max_speed=2"], "max_speed"),
+    (["--planner-changes", "sqp_iterations=2", "--planner-sqp-iterations", "1"], "sqp_iterations"),
+])
+def test_a_bad_planner_change_is_refused_by_name_with_nothing_written(tmp_path, capsys, flags, named):
+    runs = tmp_path / "runs"
+    (runs / "LBGP_s0").mkdir(parents=True)
+    shutil.copy(default_policy_path("lbgp"), runs / "LBGP_s0" / "policy.pt")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--runs", str(runs), "--episodes", "1"] + flags + ["--json", str(tmp_path / "bad.json")])
+    assert exit_info.value.code == 2 and named in capsys.readouterr().err
     assert not (tmp_path / "bad.json").exists()
 
 

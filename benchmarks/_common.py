@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import sys
@@ -12,6 +13,17 @@ def command_line(script: str, argv: list[str] | None = None) -> str:
     """The command that made a result, as results/README.md gives it: ``python benchmarks/NAME.py ARGS``
     (``argv``: the arguments main() was given; default: this process's own)."""
     return f"python benchmarks/{script} " + " ".join(sys.argv[1:] if argv is None else argv)
+
+
+def planner_changes_arg(text: str) -> dict:
+    """``--planner-changes``: NAME=VALUE pairs of ``PlannerConfig`` fields (``"max_vel_x=2.0"``), checked as
+    ``lbgp train --set train_planner_changes`` checks them; argparse names the problem otherwise."""
+    from lbgp.planner.config import changes_from_text
+
+    try:
+        return changes_from_text(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def write_result(path: str, result: dict) -> None:

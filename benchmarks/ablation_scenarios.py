@@ -54,7 +54,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import command_line, write_result  # noqa: E402
+from _common import command_line, planner_changes_arg, write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -65,7 +65,6 @@ from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
 from lbgp.experiments.tables import paired_lead  # noqa: E402
 from lbgp.metrics import reward_ci95  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
-from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 from lbgp.parallel import process_pool  # noqa: E402
@@ -136,15 +135,6 @@ def sqp_cap(text: str) -> int:
     """``--planner-sqp-iterations``: checked as ``lbgp train --set planner_sqp_iterations`` checks it."""
     try:
         return D4PGConfig.parse_setting(f"planner_sqp_iterations={text}")[1]
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
-
-
-def planner_changes_arg(text: str) -> dict:
-    """``--planner-changes``: NAME=VALUE pairs of ``PlannerConfig`` fields, checked as ``lbgp train``
-    checks ``train_planner_changes``; the problem named otherwise."""
-    try:
-        return changes_from_text(text)
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
 

@@ -28,13 +28,12 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import TOP_SPEED_VMAX, command_line, level_ceilings, write_result  # noqa: E402
+from _common import TOP_SPEED_VMAX, command_line, level_ceilings, planner_changes_arg, write_result  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
-from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import level_names  # noqa: E402
 
@@ -78,14 +77,15 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--vmax", type=float, default=TOP_SPEED_VMAX, help="the ceilings' top speed, m/s (default: the Jackal's, 2.0)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--lbgp-policy", default=None, help="LBGP policy file (default: the shipped one)")
-    ap.add_argument("--planner-changes", default="", metavar="NAME=VALUE[,...]",
+    ap.add_argument("--planner-changes", type=planner_changes_arg, default={}, metavar="NAME=VALUE[,...]",
                     help="every planner-driven method drives the Jackal preset with these settings changed, e.g. max_vel_x=2.0")
     args = ap.parse_args(argv)
+    changes = args.planner_changes
+    changed = planner_config_for("jackal", changes)
+    planner = changed if changes else None  # None: each policy's own planner, as lbgp evaluate drives it
     try:
-        changes = changes_from_text(args.planner_changes)
-        planner = planner_config_for("jackal", changes) if changes else None
         bounds = level_ceilings(args.ceiling, args.vmax)
-        planner_vmax = planner_config_for("jackal", changes).max_vel_x
+        planner_vmax = changed.max_vel_x
         planner_bounds = level_ceilings(args.ceiling, planner_vmax)
     except ValueError as exc:
         ap.error(str(exc))

@@ -18,11 +18,10 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import command_line, write_result  # noqa: E402
+from _common import command_line, planner_changes_arg, write_result  # noqa: E402
 
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
-from lbgp.planner.config import changes_from_text  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
 from lbgp.sim import scenario_names  # noqa: E402
 
@@ -34,13 +33,10 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--method", default="lbgp", choices=["lbgp", "hc", "e2e"])
     ap.add_argument("--policy", help="policy file (default: the shipped one)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--planner-changes", default="", metavar="NAME=VALUE[,...]",
+    ap.add_argument("--planner-changes", type=planner_changes_arg, default={}, metavar="NAME=VALUE[,...]",
                     help="drive the Jackal preset with these settings changed, e.g. max_vel_x=2.0 (default: none)")
     args = ap.parse_args(argv)
-    try:
-        changes = changes_from_text(args.planner_changes)
-    except ValueError as error:
-        ap.error(str(error))
+    changes = args.planner_changes
     names = scenario_names()
     per = -(-args.episodes // len(names))
     policy = make_policy(args.method, args.policy, robot="jackal")

@@ -133,6 +133,16 @@ def turn_onset(scenario: str, degrees: float, robot: str = "jackal", episode=Non
     return int(hits[0]) if hits.size else DEFAULT_HORIZON
 
 
+def padded_to_horizon(goals) -> np.ndarray:
+    """A per-step goal sequence (k, 2) extended to the episode's horizon by repeating its last goal: a
+    closed-loop method's goals stop where its episode ended early (a contact), and the steps after
+    that are never played, so any goal there replays the same episode."""
+    goals = np.asarray(goals, float).reshape(-1, 2)
+    if len(goals) == 0:
+        raise ValueError("a start sequence needs at least one goal")
+    return np.vstack([goals, np.repeat(goals[-1:], max(0, DEFAULT_HORIZON - len(goals)), axis=0)])
+
+
 def search(scenario: str, robot: str = "jackal", segment: int = 5, population: int = 24, elites: int = 6,
            iterations: int = 8, std: float = 0.4, seed: int = 0, start=None, episode=None, frozen: int = 0) -> dict:
     """Cross-entropy search over one episode's goal sequence; returns the best sequence and its return.
@@ -149,7 +159,9 @@ def search(scenario: str, robot: str = "jackal", segment: int = 5, population: i
     frozen = min(int(frozen), DEFAULT_HORIZON - 1)
     segments = -(-(DEFAULT_HORIZON - frozen) // segment)
     lo, hi = np.array([GOAL_X[0], GOAL_Y[0]]), np.array([GOAL_X[1], GOAL_Y[1]])
-    prefix = np.asarray(start, float).reshape(-1, 2)[:frozen] if frozen else np.zeros((0, 2))
+    if start is not None:
+        start = padded_to_horizon(start)
+    prefix = start[:frozen] if frozen else np.zeros((0, 2))
 
     def score(goals):
         return play(env, episode, GoalSequencePolicy(goals, segment, prefix))
@@ -159,7 +171,7 @@ def search(scenario: str, robot: str = "jackal", segment: int = 5, population: i
         mean = np.tile(np.asarray(DESIRED_GOAL, float), (segments, 1))
         best = constant
     else:
-        rest = np.asarray(start, float).reshape(-1, 2)[frozen:]
+        rest = start[frozen:]
         mean = np.array([rest[k * segment : (k + 1) * segment].mean(axis=0) for k in range(segments)])
         best = score(mean)
     sigma = np.full_like(mean, std)

@@ -8,7 +8,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
-from goal_ceiling import GoalSequencePolicy, closed_loop_goals, search, turn_onset  # noqa: E402
+from goal_ceiling import GoalSequencePolicy, closed_loop_goals, padded_to_horizon, search, turn_onset  # noqa: E402
 
 from lbgp.actions import action_from_goal  # noqa: E402
 from lbgp.rollout import run_episode  # noqa: E402
@@ -90,6 +90,18 @@ def test_a_training_level_episode_is_searched_and_replayed_by_its_seed():
     env.reseed([0, 1, 4])
     other = run_episode(env, GoalSequencePolicy(row["goals"], 7)).total_reward
     assert abs(other - row["best"]) > 1e-3
+
+
+def test_a_start_that_ended_early_is_searched_from_its_own_episode():
+    """The shipped LBGP's noise-free episode (0, 2, 13) of the smoothed level ends in a contact after
+    26 steps, so it asks for 26 goals: the search pads them with the last one (steps never played)
+    and starts at LBGP's own return instead of averaging empty segments into NaN goals."""
+    episode = (0, 2, 13)
+    lbgp, goals = closed_loop_goals("smoothed", "lbgp", episode=episode)
+    assert len(goals) < 35
+    row = search("smoothed", population=2, elites=1, iterations=1, segment=1, start=goals, episode=episode)
+    assert abs(row["start"] - lbgp) < 1e-3 and np.isfinite(row["goals"]).all() and row["best"] >= row["start"]
+    assert padded_to_horizon(goals).shape == (35, 2) and (padded_to_horizon(goals)[len(goals):] == goals[-1]).all()
 
 
 def test_the_written_result_names_the_command_that_made_it(tmp_path):

@@ -12,7 +12,7 @@ from safety_sweep import main  # noqa: E402
 from lbgp.evaluate import evaluate  # noqa: E402
 from lbgp.planner import planner_config_for  # noqa: E402
 from lbgp.policies import make_policy  # noqa: E402
-from lbgp.sim import scenario_names  # noqa: E402
+from lbgp.sim import level_names, scenario_names  # noqa: E402
 
 
 def test_the_sweep_counts_each_scenarios_episodes_on_the_planner_it_is_given(tmp_path, capsys):
@@ -36,3 +36,14 @@ def test_the_sweep_counts_each_scenarios_episodes_on_the_planner_it_is_given(tmp
         main(["--json", str(tmp_path / "bad.json"), "--planner-changes", "top_speed=2"])
     assert exit_info.value.code == 2 and "top_speed" in capsys.readouterr().err
     assert not (tmp_path / "bad.json").exists()
+
+
+def test_levels_sweeps_the_training_levels_episodes_as_evaluate_plays_them(tmp_path):
+    """--levels: one seeded, noisy random-spawn episode per training level, the same as evaluate's."""
+    result = main(["--levels", "--json", str(tmp_path / "levels.json"), "--method", "hc", "--episodes", "4"])
+    rows = evaluate(make_policy("hc", robot="jackal"), "hc", level_names(), robot="jackal", episodes=1, seed=0, obs_noise=True)
+    assert result["settings"] == "training levels" and sorted(result["per_scenario"]) == sorted(level_names())
+    for row in rows:
+        got = result["per_scenario"][row["scenario"]]
+        assert got["reward"] == pytest.approx(row["reward"], abs=1e-3)
+        assert got["contacts"] == int(row["collisions"])

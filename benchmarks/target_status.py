@@ -30,9 +30,10 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 
+from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
+
 RESULTS = Path(__file__).resolve().parents[1] / "results"
-TURNING = ("turning_ahead", "turning_behind", "turning_inside", "turning_outside")
-TRAJECTORIES = ("trajectory_one", "trajectory_two", "trajectory_three")
+TURNING, TRAJECTORIES = LEAD_ROWS["turning"], LEAD_ROWS["trajectory"]
 LEVELS = ("straight", "circles", "smoothed", "trajectories")
 
 
@@ -106,7 +107,7 @@ def simulation_table(folder: Path) -> list[dict]:
         half = _lead_half_width(folder, group)
         name, key = ceiling[group]
         sums = _get(_json(folder, name), "sums", key, source=name)
-        bound = float(sums["best"]) - float(sums["hc"])
+        bound = float(_get(sums, "best", source=name)) - float(_get(sums, "hc", source=name))
         kind = ("the best goal sequence found with the person's future known (noise-free)" if group == "turning" else
                 "the best goal sequence found that follows LBGP's goals until the person has turned 5 deg (noise-free)")
         out.append(_row(12, f"LBGP - HC summed over the {group} rows >= +{goal:g}",
@@ -126,7 +127,7 @@ def training_levels(folder: Path) -> list[dict]:
     for level in LEVELS:
         share = float(_get(lbgp, level, "share_of_ceiling", source=name))
         found = _get(searched, level, "share_of_ceiling", source=LEVEL_SEARCH)
-        bound, noise_free = float(found["best_known"]), float(found["lbgp"])
+        bound, noise_free = (float(_get(found, key, source=LEVEL_SEARCH)) for key in ("best_known", "lbgp"))
         out.append(_row(12, f"LBGP's return on the {level} level >= 60 % of its ceiling", f"{share:.0%}", share >= 0.6, name,
                         bound=f"{bound:.0%}", bound_source=LEVEL_SEARCH, beyond=0.6 > bound,
                         note="bound: per episode the best of the goal sequences found with the person's future known, "

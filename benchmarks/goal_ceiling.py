@@ -5,6 +5,7 @@
         --scenarios turning_ahead,... --json results/goal_ceiling_refined.json
     python benchmarks/goal_ceiling.py --levels straight,circles,smoothed,trajectories --episodes 8 \
         --start-from lbgp --json results/goal_ceiling_levels.json
+    ... --resume   # after a crash or a stop: keep the episodes already searched (JSON.progress.jsonl)
 
 ``lbgp.experiments.ceiling`` bounds every method from above with a relaxed point robot (no heading,
 no acceleration limit); it says nothing about what the TEB planner and the real base let a *goal*
@@ -39,6 +40,7 @@ and the relaxed point robot's ceiling.
 from __future__ import annotations
 
 import argparse
+import json
 import multiprocessing
 import os
 import sys
@@ -215,6 +217,37 @@ def one(args) -> dict:
     return row
 
 
+def _indexed(job):
+    index, args = job
+    return index, one(args)
+
+
+def run_jobs(jobs: list, workers: int, progress: Path, settings: dict, resume: bool) -> list:
+    """Every job's row, in the jobs' order. Each row is appended to ``progress`` (JSON lines, the
+    settings first) as soon as its job finishes, so a crash or a stopped run loses only the jobs in
+    flight; ``resume`` takes the rows of a progress file with the same settings and runs the rest.
+    The file is removed once every job is done."""
+    settings = json.loads(json.dumps(settings))  # as the file holds them (tuples become lists)
+    done: dict[int, dict] = {}
+    if resume and progress.is_file():
+        lines = [json.loads(line) for line in progress.read_text().splitlines() if line.strip()]
+        if not lines or lines[0].get("settings") != settings:
+            raise ValueError(f"{progress}: made with other settings ({lines[0].get('settings') if lines else 'empty'}); "
+                             "rerun without --resume to start again")
+        done = {int(line["index"]): line["row"] for line in lines[1:]}
+    else:
+        progress.parent.mkdir(parents=True, exist_ok=True)
+        progress.write_text(json.dumps({"settings": settings}) + "\n")
+    todo = [(i, job) for i, job in enumerate(jobs) if i not in done]
+    with multiprocessing.get_context("spawn").Pool(workers) as pool, progress.open("a") as log:
+        for index, row in pool.imap_unordered(_indexed, todo, chunksize=1):
+            done[index] = row
+            log.write(json.dumps({"index": index, "row": row}) + "\n")
+            log.flush()
+    progress.unlink()
+    return [done[i] for i in range(len(jobs))]
+
+
 def level_summary(rows: list, ceiling: float) -> dict:
     """Mean over a level's episodes of each return, and its share of the level's point-robot ceiling.
     ``best_known``: per episode the best of the search, the constant goal, HC and LBGP (each a goal
@@ -245,6 +278,8 @@ def main(argv=None) -> dict:
                    help="hold LBGP's own goals until the person has turned by this many degrees, search only after "
                         "(needs --start-from lbgp)")
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
+    p.add_argument("--resume", action="store_true",
+                   help="keep the rows of an interrupted run with the same settings (JSON.progress.jsonl) and run the rest")
     args = p.parse_args(argv)
     if args.react_after_deg is not None and (args.start_from != "lbgp" or args.react_after_deg <= 0):
         p.error("--react-after-deg needs --start-from lbgp and a positive angle")
@@ -264,8 +299,12 @@ def main(argv=None) -> dict:
                 for name in levels for i in range(args.episodes)]
     else:
         jobs = [(s, args.robot, args.start_from, kwargs, None, args.react_after_deg) for s in args.scenarios.split(",") if s]
-    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        done = pool.map(one, jobs, chunksize=1)
+    progress = Path(f"{args.json}.progress.jsonl")
+    try:
+        done = run_jobs(jobs, args.workers, progress, {**settings, "jobs": [list(map(str, j[:2])) + [j[4]] for j in jobs]},
+                        args.resume)
+    except ValueError as error:
+        p.error(str(error))
     if args.levels:
         rows = {name: level_summary([r for j, r in zip(jobs, done) if j[0] == name], ceilings[name]) for name in levels}
         result = {"benchmark": "goal_ceiling_levels", "robot": args.robot, "settings": {**settings, "episodes": args.episodes},

@@ -125,3 +125,30 @@ def test_react_after_needs_lbgps_goals_to_hold(capsys):
     with pytest.raises(SystemExit):
         main(["--scenarios", "trajectory_three", "--react-after-deg", "5", "--json", "unused.json"])
     assert "--react-after-deg needs --start-from lbgp" in capsys.readouterr().err
+
+
+def test_finished_jobs_are_kept_in_a_progress_file_and_resume_runs_only_the_rest(tmp_path, capsys):
+    """A run records each finished job's row as it comes; --resume with the same settings keeps
+    those rows (a planted one comes back unchanged) and runs only the missing jobs; other settings
+    are refused by name; a finished run leaves no progress file."""
+    import json
+
+    from goal_ceiling import main
+
+    out = tmp_path / "gc.json"
+    args = ["--scenarios", "straight_ahead,straight_behind", "--iterations", "1", "--population", "2", "--segment", "35",
+            "--workers", "1", "--json", str(out)]
+    first = main(args)
+    progress = tmp_path / "gc.json.progress.jsonl"
+    assert not progress.exists()
+    settings = {**first["settings"], "jobs": [[s, "jackal", None] for s in ("straight_ahead", "straight_behind")]}
+    planted = {**first["scenarios"]["straight_behind"], "best": 123.0}
+    progress.write_text(json.dumps({"settings": settings}) + "\n" + json.dumps({"index": 1, "row": planted}) + "\n")
+    resumed = main(args + ["--resume"])
+    assert resumed["scenarios"]["straight_behind"]["best"] == 123.0
+    assert resumed["scenarios"]["straight_ahead"] == first["scenarios"]["straight_ahead"]
+    assert not progress.exists()
+    progress.write_text(json.dumps({"settings": {**settings, "iterations": 5}}) + "\n")
+    with pytest.raises(SystemExit):
+        main(args + ["--resume"])
+    assert "other settings" in capsys.readouterr().err and progress.exists()

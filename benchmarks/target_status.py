@@ -31,10 +31,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import command_line, write_result  # noqa: E402
 
 from lbgp.experiments.sim_table import LEAD_ROWS  # noqa: E402
+from lbgp.sim import level_names  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parents[1] / "results"
 TURNING, TRAJECTORIES = LEAD_ROWS["turning"], LEAD_ROWS["trajectory"]
-LEVELS = ("straight", "circles", "smoothed", "trajectories")
 
 
 class ResultsError(ValueError):
@@ -51,12 +51,16 @@ def _json(folder: Path, name: str) -> dict:
         raise ResultsError(f"{path}: not valid JSON ({error})") from None
 
 
-def _rows(folder: Path, name: str) -> list[dict]:
+def _rows(folder: Path, name: str, columns: tuple[str, ...]) -> list[dict]:
     path = folder / name
     if not path.is_file():
         raise ResultsError(f"{path}: missing (made by the command results/README.md gives for it)")
     with path.open(newline="") as f:
-        return list(csv.DictReader(f))
+        reader = csv.DictReader(f)
+        absent = [c for c in columns if c not in (reader.fieldnames or ())]
+        if absent:
+            raise ResultsError(f"{path}: has no column {', '.join(absent)}")
+        return list(reader)
 
 
 def _get(data: dict, *keys, source: str):
@@ -84,7 +88,7 @@ def _lead_half_width(folder: Path, rows_name: str) -> float | None:
 
 
 def simulation_table(folder: Path) -> list[dict]:
-    rows = _rows(folder, "sim_table.csv")
+    rows = _rows(folder, "sim_table.csv", ("scenario", "method", "reward", "winner_ours"))
     reward = {(r["scenario"], r["method"]): float(r["reward"]) for r in rows}
     winner = {r["scenario"]: r["winner_ours"] for r in rows}
     source = "sim_table.csv"
@@ -124,7 +128,7 @@ def training_levels(folder: Path) -> list[dict]:
     lbgp = _get(_json(folder, name), "methods", "lbgp", source=name)
     searched = _get(_json(folder, LEVEL_SEARCH), "levels", source=LEVEL_SEARCH)
     out = []
-    for level in LEVELS:
+    for level in level_names():
         share = float(_get(lbgp, level, "share_of_ceiling", source=name))
         found = _get(searched, level, "share_of_ceiling", source=LEVEL_SEARCH)
         bound, noise_free = (float(_get(found, key, source=LEVEL_SEARCH)) for key in ("best_known", "lbgp"))
@@ -136,7 +140,7 @@ def training_levels(folder: Path) -> list[dict]:
 
 
 def real_protocol(folder: Path) -> list[dict]:
-    rows = _rows(folder, "real_protocol_table.csv")
+    rows = _rows(folder, "real_protocol_table.csv", ("path", "setting", "method", "reward"))
     reward = {(r["path"], r["setting"], r["method"]): float(r["reward"]) for r in rows}
     settings = sorted({(p, s) for p, s, _ in reward})
     missing = [f"{p}/{s}" for p, s in settings if (p, s, "lbgp") not in reward or (p, s, "hc") not in reward]
@@ -156,43 +160,45 @@ def safety(folder: Path) -> list[dict]:
 
 
 def planner(folder: Path) -> list[dict]:
-    bench = _json(folder, "bench_planner.json")
-    env = _json(folder, "bench_env.json")
-    sweep = _json(folder, "goal_sweep.json")
+    bench, env, sweep = (_json(folder, name) for name in ("bench_planner.json", "bench_env.json", "goal_sweep.json"))
     out = []
     for robot in ("jackal", "turtlebot2"):
-        calls = _get(bench, f"{robot}_N20", source="bench_planner.json")
-        median, p99 = float(calls["median_ms"]), float(calls["p99_ms"])
-        osqp = _get(calls, "osqp_ms", source="bench_planner.json")
+        def calls(*keys):
+            return float(_get(bench, f"{robot}_N20", *keys, source="bench_planner.json"))
+
+        median, p99, osqp_median, osqp_p99 = (calls(*k) for k in (("median_ms",), ("p99_ms",), ("osqp_ms", "median"),
+                                                                   ("osqp_ms", "p99")))
         out.append(_row(11, f"{robot}: planner call median <= 0.5 ms (N = 20)", round(median, 2), median <= 0.5, "bench_planner.json",
-                        bound=round(float(osqp["median"]), 2), bound_source="bench_planner.json",
-                        beyond=0.5 < float(osqp["median"]),
+                        bound=round(osqp_median, 2), bound_source="bench_planner.json", beyond=0.5 < osqp_median,
                         note="bound: the median call's time inside OSQP alone (a lower bound on the call with today's QPs)"))
         out.append(_row(11, f"{robot}: planner call p99 <= 1.5 ms (N = 20)", round(p99, 1), p99 <= 1.5, "bench_planner.json",
-                        bound=round(float(osqp["p99"]), 1), bound_source="bench_planner.json", note="bound: OSQP's own p99",
-                        beyond=1.5 < float(osqp["p99"])))
-        hits = int(_get(calls, "osqp_iteration_cap_hits", source="bench_planner.json"))
-        out.append(_row(11, f"{robot}: OSQP never stops at its iteration cap", f"{hits} of {calls['qp_solves']} QPs", hits == 0,
+                        bound=round(osqp_p99, 1), bound_source="bench_planner.json", note="bound: OSQP's own p99",
+                        beyond=1.5 < osqp_p99))
+        hits, solves = int(calls("osqp_iteration_cap_hits")), int(calls("qp_solves"))
+        out.append(_row(11, f"{robot}: OSQP never stops at its iteration cap", f"{hits} of {solves} QPs", hits == 0,
                         "bench_planner.json"))
-        accuracy = calls.get("accuracy_vs_tight_reference_m")
-        if accuracy is not None:
-            worst = float(accuracy["max"])
+        if "accuracy_vs_tight_reference_m" in bench[f"{robot}_N20"]:
+            worst, qps = calls("accuracy_vs_tight_reference_m", "max"), int(calls("accuracy_vs_tight_reference_m", "qps"))
             out.append(_row(11, f"{robot}: each QP's step within 1 cm of a tightly solved reference",
-                            f"max {worst * 100:.2f} cm over {accuracy['qps']} QPs", worst <= 0.01, "bench_planner.json"))
-        rates = _get(env, "robots", robot, source="bench_env.json")
-        share = float(rates["task_goal_steps_per_s"]) / float(rates["raw_mj_step_agent_steps_per_s"])
+                            f"max {worst * 100:.2f} cm over {qps} QPs", worst <= 0.01, "bench_planner.json"))
+        goal_rate, raw_rate = (float(_get(env, "robots", robot, key, source="bench_env.json"))
+                               for key in ("task_goal_steps_per_s", "raw_mj_step_agent_steps_per_s"))
+        share = goal_rate / raw_rate
         out.append(_row(11, f"{robot}: goal-driven env >= 40 % of the raw-physics agent-step rate", f"{share:.1%}", share >= 0.4,
                         "bench_env.json"))
-        summary = _get(sweep, robot, "summary", source="goal_sweep.json")
-        change = float(summary["largest_neighbour_change_goals_to_1_9"])
+
+        def summary(key):
+            return float(_get(sweep, robot, "summary", key, source="goal_sweep.json"))
+
+        change = summary("largest_neighbour_change_goals_to_1_9")
         out.append(_row(11, f"{robot}: goal sweep, largest reward change between goals 5 cm apart <= 3 (goals up to 1.9 m)",
                         round(change, 2), change <= 3, "goal_sweep.json",
-                        note=f"over the whole sweep to 2.2 m: {float(summary['largest_neighbour_change']):.2f}, where the reward "
+                        note=f"over the whole sweep to 2.2 m: {summary('largest_neighbour_change'):.2f}, where the reward "
                              "itself steps at D = 2 m (docs/planner.md)"))
-        lowest = float(summary["straight_ahead_min_1_2_to_1_8"])
+        lowest = summary("straight_ahead_min_1_2_to_1_8")
         out.append(_row(11, f"{robot}: goal sweep, straight_ahead >= 20 for every goal 1.2-1.8 m ahead", round(lowest, 1),
                         lowest >= 20, "goal_sweep.json"))
-        loops = int(summary["loops"])
+        loops = int(summary("loops"))
         out.append(_row(11, f"{robot}: goal sweep, 0 loops", loops, loops == 0, "goal_sweep.json"))
     kept = float(_get(_json(folder, "goal_jitter.json"), "kept", source="goal_jitter.json"))
     out.append(_row(11, "HC with 0.1 m goal jitter keeps >= 90 % of its turning-row reward", f"{kept:.1%}", kept >= 0.9,

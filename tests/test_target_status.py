@@ -48,7 +48,8 @@ def test_the_leads_are_the_tables_row_sums_and_flip_at_their_targets(results, tm
     """The trajectory lead is LBGP - HC summed over the three rows of the CSV; raising LBGP's
     trajectory_three reward until the sum passes +5 turns that target met, and nothing else."""
     before = main(["--results", str(results), "--json", str(tmp_path / "before.json")])
-    rows = _edit_csv(results / "sim_table.csv", lambda r: None)
+    with (results / "sim_table.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
     reward = {(r["scenario"], r["method"]): float(r["reward"]) for r in rows}
     lead = sum(reward[(s, "lbgp")] - reward[(s, "hc")] for s in ("trajectory_one", "trajectory_two", "trajectory_three"))
     row = _row(before, "LBGP - HC summed over the trajectory rows")
@@ -110,3 +111,15 @@ def test_a_missing_or_broken_file_is_named_and_nothing_is_written(results, tmp_p
     with pytest.raises(SystemExit):
         main(["--results", str(results), "--markdown", str(tmp_path / "status.md")])
     assert "goal_jitter.json: has no kept" in capsys.readouterr().err and not (tmp_path / "status.md").exists()
+    shutil.copy(RESULTS / "goal_jitter.json", results / "goal_jitter.json")
+    bench = json.loads((results / "bench_planner.json").read_text())
+    del bench["turtlebot2_N20"]["osqp_ms"]["p99"]
+    (results / "bench_planner.json").write_text(json.dumps(bench))
+    with pytest.raises(SystemExit):
+        main(["--results", str(results), "--json", str(out)])
+    assert "bench_planner.json: has no turtlebot2_N20/osqp_ms/p99" in capsys.readouterr().err and not out.exists()
+    shutil.copy(RESULTS / "bench_planner.json", results / "bench_planner.json")
+    _edit_csv(results / "sim_table.csv", lambda r: r.pop("winner_ours"))
+    with pytest.raises(SystemExit):
+        main(["--results", str(results), "--json", str(out)])
+    assert "sim_table.csv: has no column winner_ours" in capsys.readouterr().err and not out.exists()

@@ -301,8 +301,8 @@ def main(argv=None) -> dict:
         jobs = [(s, args.robot, args.start_from, kwargs, None, args.react_after_deg) for s in args.scenarios.split(",") if s]
     progress = Path(f"{args.json}.progress.jsonl")
     try:
-        done = run_jobs(jobs, args.workers, progress, {**settings, "jobs": [list(map(str, j[:2])) + [j[4]] for j in jobs]},
-                        args.resume)
+        which = [[name, robot, episode] for name, robot, _, _, episode, _ in jobs]  # what each job searches
+        done = run_jobs(jobs, args.workers, progress, {**settings, "jobs": which}, args.resume)
     except ValueError as error:
         p.error(str(error))
     if args.levels:
